@@ -1,0 +1,145 @@
+//! Errors of hbal: every variant names the place (element, DOF, harmonic, parameter) so that a
+//! user can act on the message.
+
+/// Result alias used throughout hbal.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// What went wrong, and where.
+///
+/// Problems with the iteration itself (divergence, running out of iterations, a non-finite
+/// iterate) are not errors: they are a [`Termination`](crate::Termination) of the returned
+/// [`Solution`](crate::Solution), which keeps the last good iterate.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// A parameter is non-finite or outside its physical range.
+    #[error("{context}: parameter `{name}` must be {requirement}, got {value}")]
+    InvalidParameter {
+        /// Where the parameter lives, e.g. `element "mesh" (mesh_stiffness)`.
+        context: String,
+        /// The parameter's name as in a scene file.
+        name: String,
+        /// The offending value.
+        value: f64,
+        /// The rule it breaks, e.g. `finite and >= 0`.
+        requirement: String,
+    },
+    /// An element or load names a DOF the model does not have.
+    #[error("{context}: unknown DOF `{name}` (the model has: {known})")]
+    UnknownDof {
+        /// Where the name was used.
+        context: String,
+        /// The unknown name.
+        name: String,
+        /// The model's DOF names, comma separated.
+        known: String,
+    },
+    /// Two DOFs share a name, or there are none.
+    #[error("invalid DOF list: {reason}")]
+    InvalidDofs {
+        /// Why the list is rejected.
+        reason: String,
+    },
+    /// A matrix or vector has the wrong size.
+    #[error("{context}: expected {expected}, got {got}")]
+    DimensionMismatch {
+        /// Which matrix or vector.
+        context: String,
+        /// The size it must have.
+        expected: String,
+        /// The size it has.
+        got: String,
+    },
+    /// The mass matrix is not symmetric positive definite.
+    #[error("mass matrix is not symmetric positive definite: {reason}")]
+    MassNotPositiveDefinite {
+        /// What failed (asymmetry, a non-positive pivot, ...).
+        reason: String,
+    },
+    /// N time samples cannot carry H harmonics.
+    #[error("{samples} time samples cannot resolve {harmonics} harmonics: need N >= 2H+1 = {}", 2 * .harmonics + 1)]
+    TooFewSamples {
+        /// H.
+        harmonics: usize,
+        /// N.
+        samples: usize,
+    },
+    /// A load has an order above the number of harmonics.
+    #[error("load on DOF `{dof}` has order {order} but only {harmonics} harmonics are kept: raise H to at least {order}")]
+    LoadOrderTooHigh {
+        /// DOF of the load.
+        dof: String,
+        /// Harmonic order of the load.
+        order: usize,
+        /// H.
+        harmonics: usize,
+    },
+    /// The dynamic stiffness `-(k Ω)² M + i k Ω D0 + K0` is singular at harmonic `k`:
+    /// an undamped resonance (or, at k = 0, a rigid-body mode under a static load).
+    #[error("dynamic stiffness is singular at harmonic {harmonic} (frequency {omega} rad/s, relative pivot {relative_pivot:.3e}): {hint}")]
+    SingularDynamicStiffness {
+        /// Harmonic index k.
+        harmonic: usize,
+        /// k Ω in rad/s.
+        omega: f64,
+        /// Smallest LU pivot relative to the matrix scale.
+        relative_pivot: f64,
+        /// What to change.
+        hint: String,
+    },
+    /// A computation produced NaN or infinity.
+    #[error("non-finite value in {what}")]
+    NonFinite {
+        /// Which quantity.
+        what: String,
+    },
+    /// The time-domain reference integration failed.
+    #[error("time integration failed: {reason}")]
+    TimeIntegration {
+        /// The integrator's reason.
+        reason: String,
+    },
+}
+
+impl Error {
+    /// Shorthand for [`Error::InvalidParameter`].
+    pub fn invalid(
+        context: impl Into<String>,
+        name: impl Into<String>,
+        value: f64,
+        requirement: impl Into<String>,
+    ) -> Self {
+        Error::InvalidParameter {
+            context: context.into(),
+            name: name.into(),
+            value,
+            requirement: requirement.into(),
+        }
+    }
+}
+
+/// Checks that `value` is finite and `>= 0`.
+pub(crate) fn check_non_negative(context: &str, name: &str, value: f64) -> Result<()> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(context, name, value, "finite and >= 0"))
+    }
+}
+
+/// Checks that `value` is finite and `> 0`.
+pub(crate) fn check_positive(context: &str, name: &str, value: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(context, name, value, "finite and > 0"))
+    }
+}
+
+/// Checks that `value` is finite.
+pub(crate) fn check_finite(context: &str, name: &str, value: f64) -> Result<()> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::invalid(context, name, value, "finite"))
+    }
+}

@@ -1,0 +1,118 @@
+//! Force elements behind one trait.
+//!
+//! A force element acts on a scalar local coordinate `u = w·q` (see
+//! [`Element`](crate::Element)) and returns the restoring force `f(θ, u, u̇)`, where
+//! `θ = Ω t` is the angle of the fundamental (the law is 2π-periodic in θ). The element's force
+//! on the model is `-w f`, so that a linear spring `f = k u` adds `k w wᵀ` to the stiffness.
+//!
+//! For the paper's split `K(t) = K0 + K1(t)`, `D(t) = D0 + D1(t)` every law names its constant
+//! linear part `(k0, d0)` ([`ForceLaw::linear_part`]); the harmonic-balance iteration keeps
+//! `k0 w wᵀ` in `K0` and evaluates only the rest `f - k0 u - d0 u̇` in the time domain.
+//!
+//! Built-in laws (scene-file names in brackets): [`LinearSpring`] (`linear_spring`),
+//! [`MeshStiffness`] (`mesh_stiffness`), [`Backlash`] (`backlash`), [`CubicSpring`]
+//! (`cubic_spring`). Implement [`ForceLaw`] in your own crate for anything else and check its
+//! derivatives with [`check_derivatives`].
+
+mod backlash;
+mod check;
+mod cubic_spring;
+mod linear_spring;
+mod mesh_stiffness;
+mod profile;
+
+pub use backlash::Backlash;
+pub use check::{check_derivatives, DerivativeCheck};
+pub use cubic_spring::CubicSpring;
+pub use linear_spring::LinearSpring;
+pub use mesh_stiffness::MeshStiffness;
+pub use profile::{MeshDamping, MeshProfile};
+
+use crate::Result;
+use std::f64::consts::TAU;
+
+/// The constant linear part `(k0, d0)` of a force law, kept in `K0` and `D0`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct LinearPart {
+    /// Stiffness `k0 = ∂f/∂u`, averaged.
+    pub stiffness: f64,
+    /// Damping `d0 = ∂f/∂u̇`, averaged.
+    pub damping: f64,
+}
+
+/// A scalar force law `f(θ, u, u̇)` of one element.
+///
+/// `θ = Ω t` is the angle of the fundamental; the law must be 2π-periodic in θ. Implementations
+/// must be `Send + Sync` and serialisable (`#[typetag::serde(name = "...")]` gives the scene-file
+/// name).
+///
+/// # Example: a user law
+/// ```
+/// use hbal::force::ForceLaw;
+///
+/// /// A quadratic damper `f = c u̇ |u̇|`.
+/// #[derive(Debug, serde::Serialize, serde::Deserialize)]
+/// struct QuadraticDamper { c: f64 }
+///
+/// #[typetag::serde(name = "quadratic_damper")]
+/// impl ForceLaw for QuadraticDamper {
+///     fn force(&self, _theta: f64, _u: f64, du: f64) -> f64 { self.c * du * du.abs() }
+///     fn derivatives(&self, _theta: f64, _u: f64, du: f64) -> (f64, f64) {
+///         (0.0, 2.0 * self.c * du.abs())
+///     }
+/// }
+/// let law = QuadraticDamper { c: 2.0 };
+/// assert_eq!(law.force(0.0, 0.0, -3.0), -18.0);
+/// let check = hbal::force::check_derivatives(&law, &[(0.3, 0.1, 0.7)]);
+/// assert!(check.max_relative_error < 1e-6);
+/// ```
+#[typetag::serde(tag = "type")]
+pub trait ForceLaw: std::fmt::Debug + Send + Sync {
+    /// The restoring force `f(θ, u, u̇)`.
+    fn force(&self, theta: f64, u: f64, du: f64) -> f64;
+
+    /// The partial derivatives `(∂f/∂u, ∂f/∂u̇)` at `(θ, u, u̇)`, for Newton-type solvers.
+    ///
+    /// Where the law has a kink (contact), return either one-sided value.
+    fn derivatives(&self, theta: f64, u: f64, du: f64) -> (f64, f64);
+
+    /// The constant linear part `(k0, d0)` kept in `K0`, `D0`.
+    ///
+    /// Default: the time average of the linearisation at `u = u̇ = 0`,
+    /// `k0 = (1/2π) ∫ ∂f/∂u(θ, 0, 0) dθ` (64-point rule), as in the paper's split
+    /// `K(t) = K0 + K1(t)`. Override it where that average is a poor centre for the
+    /// iteration (a contact that is open at `u = 0`).
+    fn linear_part(&self) -> LinearPart {
+        const POINTS: usize = 64;
+        let (mut k, mut d) = (0.0, 0.0);
+        for j in 0..POINTS {
+            let (dk, dd) = self.derivatives(TAU * j as f64 / POINTS as f64, 0.0, 0.0);
+            k += dk;
+            d += dd;
+        }
+        LinearPart {
+            stiffness: k / POINTS as f64,
+            damping: d / POINTS as f64,
+        }
+    }
+
+    /// Angles `θ ∈ [0, 2π)` where the force jumps in time (a rectangular mesh stiffness).
+    ///
+    /// The time-domain reference restarts its integrator there; the AFT samples a jump with the
+    /// mean of both one-sided limits, the value a Fourier series converges to. Default: none.
+    fn time_breakpoints(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    /// `true` if the force is exactly `k0 u + d0 u̇` at all times: the element then lives
+    /// entirely in `K0`, `D0` and costs nothing in the time domain. Default: `false`.
+    fn is_linear_time_invariant(&self) -> bool {
+        false
+    }
+
+    /// Checks the parameters; `context` names the element in messages. Default: accepts.
+    fn validate(&self, context: &str) -> Result<()> {
+        let _ = context;
+        Ok(())
+    }
+}

@@ -1,0 +1,93 @@
+//! The dynamic stiffness `Z_k = -(kΩ)² M + i kΩ D0 + K0` per harmonic, factored once.
+
+use super::HarmonicBasis;
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, DVectorViewMut, Dyn, LU};
+use num_complex::Complex64;
+
+/// Smallest accepted LU pivot relative to the scale of `Z_k`; below it `Z_k` counts as singular
+/// (nalgebra's LU only reports exactly zero pivots).
+pub const SINGULAR_PIVOT: f64 = 1e-11;
+
+/// `Z_k` and its LU factors for `k = 0..=H`.
+#[derive(Debug, Clone)]
+pub struct DynamicStiffness {
+    n: usize,
+    matrices: Vec<DMatrix<Complex64>>,
+    factors: Vec<LU<Complex64, Dyn, Dyn>>,
+}
+
+impl DynamicStiffness {
+    /// Builds and factors `Z_k`; an error names the first singular harmonic.
+    pub fn new(
+        basis: &HarmonicBasis,
+        m: &DMatrix<f64>,
+        d0: &DMatrix<f64>,
+        k0: &DMatrix<f64>,
+    ) -> Result<Self> {
+        let n = m.nrows();
+        let mut matrices = Vec::with_capacity(basis.harmonics() + 1);
+        let mut factors = Vec::with_capacity(basis.harmonics() + 1);
+        for k in 0..=basis.harmonics() {
+            let w = k as f64 * basis.omega();
+            let z = DMatrix::from_fn(n, n, |i, j| {
+                Complex64::new(k0[(i, j)] - w * w * m[(i, j)], w * d0[(i, j)])
+            });
+            let scale = k0.amax().max(w * w * m.amax()).max(w * d0.amax());
+            let lu = z.clone().lu();
+            let u = lu.u();
+            let min_pivot = (0..n).map(|i| u[(i, i)].norm()).fold(f64::INFINITY, f64::min);
+            let relative_pivot = if scale > 0.0 { min_pivot / scale } else { 0.0 };
+            if !(relative_pivot > SINGULAR_PIVOT) {
+                let hint = if k == 0 {
+                    "K0 is singular: a free rigid-body mode; ground it with a stiffness or \
+                     fix the DOF"
+                        .to_string()
+                } else {
+                    format!(
+                        "an undamped natural frequency at {w} rad/s coincides with harmonic {k}; \
+                         add damping or shift the speed"
+                    )
+                };
+                return Err(Error::SingularDynamicStiffness {
+                    harmonic: k,
+                    omega: w,
+                    relative_pivot,
+                    hint,
+                });
+            }
+            matrices.push(z);
+            factors.push(lu);
+        }
+        Ok(Self {
+            n,
+            matrices,
+            factors,
+        })
+    }
+
+    /// `Z_k`.
+    pub fn matrix(&self, k: usize) -> &DMatrix<Complex64> {
+        &self.matrices[k]
+    }
+
+    /// `x ← Z_k⁻¹ x` for the n entries of harmonic k (no allocation).
+    #[inline]
+    pub fn solve_in_place(&self, k: usize, x: &mut [Complex64]) {
+        let mut v = DVectorViewMut::from_slice(x, self.n);
+        self.factors[k].solve_mut(&mut v);
+    }
+
+    /// `out ← Z_k x`.
+    #[inline]
+    pub fn apply(&self, k: usize, x: &[Complex64], out: &mut [Complex64]) {
+        let z = &self.matrices[k];
+        for (i, o) in out.iter_mut().enumerate() {
+            let mut acc = Complex64::default();
+            for (j, xj) in x.iter().enumerate() {
+                acc += z[(i, j)] * xj;
+            }
+            *o = acc;
+        }
+    }
+}

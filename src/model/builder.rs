@@ -1,0 +1,213 @@
+//! Validating builder for [`Model`].
+
+use super::{Element, Load, Model};
+use crate::error::{Error, Result};
+use crate::force::ForceLaw;
+use nalgebra::DMatrix;
+
+/// Collects a model's parts; [`ModelBuilder::build`] validates them all.
+#[derive(Debug)]
+pub struct ModelBuilder {
+    dofs: Vec<String>,
+    mass: Option<DMatrix<f64>>,
+    damping: Option<DMatrix<f64>>,
+    stiffness: Option<DMatrix<f64>>,
+    loads: Vec<(String, usize, f64, f64)>,
+    elements: Vec<(String, Vec<(String, f64)>, Box<dyn ForceLaw>)>,
+}
+
+impl ModelBuilder {
+    pub(super) fn new(dofs: &[&str]) -> Self {
+        Self {
+            dofs: dofs.iter().map(|s| s.to_string()).collect(),
+            mass: None,
+            damping: None,
+            stiffness: None,
+            loads: Vec::new(),
+            elements: Vec::new(),
+        }
+    }
+
+    /// Mass matrix M (n × n, symmetric positive definite). Required.
+    pub fn mass(mut self, m: DMatrix<f64>) -> Self {
+        self.mass = Some(m);
+        self
+    }
+
+    /// Diagonal mass matrix.
+    pub fn mass_diagonal(self, m: &[f64]) -> Self {
+        let n = m.len();
+        self.mass(DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(
+            &m[..n],
+        )))
+    }
+
+    /// Structural damping D (n × n), default zero.
+    pub fn damping(mut self, d: DMatrix<f64>) -> Self {
+        self.damping = Some(d);
+        self
+    }
+
+    /// Structural stiffness K (n × n), default zero.
+    pub fn stiffness(mut self, k: DMatrix<f64>) -> Self {
+        self.stiffness = Some(k);
+        self
+    }
+
+    /// Adds `cos · cos(k Ω t) + sin · sin(k Ω t)` to the load on `dof` (k = 0: static).
+    pub fn load(mut self, dof: &str, order: usize, cos: f64, sin: f64) -> Self {
+        self.loads.push((dof.to_string(), order, cos, sin));
+        self
+    }
+
+    /// Adds a force element `law` on `u = Σ w_i q_i` over the named DOFs.
+    pub fn element(self, name: &str, weights: &[(&str, f64)], law: impl ForceLaw + 'static) -> Self {
+        self.element_boxed(name, weights, Box::new(law))
+    }
+
+    /// Adds a boxed force element (e.g. deserialised from a scene file).
+    pub fn element_boxed(mut self, name: &str, weights: &[(&str, f64)], law: Box<dyn ForceLaw>) -> Self {
+        let w = weights.iter().map(|(d, w)| (d.to_string(), *w)).collect();
+        self.elements.push((name.to_string(), w, law));
+        self
+    }
+
+    /// Validates and builds the model.
+    pub fn build(self) -> Result<Model> {
+        let n = self.dofs.len();
+        if n == 0 {
+            return Err(Error::InvalidDofs {
+                reason: "the model has no DOFs".into(),
+            });
+        }
+        for (i, d) in self.dofs.iter().enumerate() {
+            if d.trim().is_empty() {
+                return Err(Error::InvalidDofs {
+                    reason: format!("DOF {i} has an empty name"),
+                });
+            }
+            if self.dofs[..i].contains(d) {
+                return Err(Error::InvalidDofs {
+                    reason: format!("DOF name `{d}` appears twice"),
+                });
+            }
+        }
+        let known = self.dofs.join(", ");
+        let index = |context: &str, name: &str| -> Result<usize> {
+            self.dofs
+                .iter()
+                .position(|d| d == name)
+                .ok_or_else(|| Error::UnknownDof {
+                    context: context.to_string(),
+                    name: name.to_string(),
+                    known: known.clone(),
+                })
+        };
+
+        let mass = self.mass.clone().ok_or_else(|| Error::MassNotPositiveDefinite {
+            reason: "no mass matrix given".into(),
+        })?;
+        check_matrix("mass matrix", &mass, n)?;
+        check_spd(&mass)?;
+        let damping = self.damping.clone().unwrap_or_else(|| DMatrix::zeros(n, n));
+        check_matrix("damping matrix", &damping, n)?;
+        let stiffness = self.stiffness.clone().unwrap_or_else(|| DMatrix::zeros(n, n));
+        check_matrix("stiffness matrix", &stiffness, n)?;
+
+        let mut loads = Vec::with_capacity(self.loads.len());
+        for (dof, order, c, s) in &self.loads {
+            let ctx = format!("load on `{dof}` order {order}");
+            let i = index(&ctx, dof)?;
+            crate::error::check_finite(&ctx, "cos", *c)?;
+            crate::error::check_finite(&ctx, "sin", *s)?;
+            loads.push(Load {
+                dof: i,
+                order: *order,
+                cos: *c,
+                sin: if *order == 0 { 0.0 } else { *s },
+            });
+        }
+
+        let mut elements = Vec::with_capacity(self.elements.len());
+        for (name, weights, law) in self.elements {
+            let ctx = format!("element `{name}`");
+            if weights.is_empty() {
+                return Err(Error::DimensionMismatch {
+                    context: format!("{ctx} weights"),
+                    expected: "at least one (DOF, weight) pair".into(),
+                    got: "none".into(),
+                });
+            }
+            let mut w = Vec::with_capacity(weights.len());
+            for (dof, wi) in &weights {
+                let i = index(&ctx, dof)?;
+                crate::error::check_finite(&ctx, &format!("weight of `{dof}`"), *wi)?;
+                if w.iter().any(|(j, _)| *j == i) {
+                    return Err(Error::InvalidDofs {
+                        reason: format!("{ctx} names DOF `{dof}` twice"),
+                    });
+                }
+                w.push((i, *wi));
+            }
+            law.validate(&ctx)?;
+            let linear = law.linear_part();
+            crate::error::check_finite(&ctx, "linear part k0", linear.stiffness)?;
+            crate::error::check_finite(&ctx, "linear part d0", linear.damping)?;
+            elements.push(Element {
+                name,
+                weights: w,
+                law,
+                linear,
+            });
+        }
+
+        Ok(Model {
+            dofs: self.dofs,
+            mass,
+            damping,
+            stiffness,
+            loads,
+            elements,
+        })
+    }
+}
+
+fn check_matrix(context: &str, m: &DMatrix<f64>, n: usize) -> Result<()> {
+    if m.nrows() != n || m.ncols() != n {
+        return Err(Error::DimensionMismatch {
+            context: context.into(),
+            expected: format!("{n} x {n} (one row and column per DOF)"),
+            got: format!("{} x {}", m.nrows(), m.ncols()),
+        });
+    }
+    if let Some(((i, j), v)) = m
+        .iter()
+        .enumerate()
+        .map(|(idx, v)| ((idx % n, idx / n), v))
+        .find(|(_, v)| !v.is_finite())
+    {
+        return Err(Error::invalid(
+            context,
+            format!("[{i}][{j}]"),
+            *v,
+            "finite",
+        ));
+    }
+    Ok(())
+}
+
+fn check_spd(m: &DMatrix<f64>) -> Result<()> {
+    let scale = m.amax();
+    let asym = (m - m.transpose()).amax();
+    if asym > 1e-12 * scale {
+        return Err(Error::MassNotPositiveDefinite {
+            reason: format!("not symmetric (largest |M - Mᵀ| entry {asym:.3e})"),
+        });
+    }
+    if m.clone().cholesky().is_none() || scale == 0.0 {
+        return Err(Error::MassNotPositiveDefinite {
+            reason: "Cholesky factorisation failed (a zero or negative mass or inertia?)".into(),
+        });
+    }
+    Ok(())
+}

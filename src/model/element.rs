@@ -1,0 +1,69 @@
+//! A force element: a [`ForceLaw`] on the local coordinate `u = w·q`.
+
+use crate::force::{ForceLaw, LinearPart};
+use nalgebra::DMatrix;
+
+/// A force element: law `f(θ, u, u̇)` on `u = w·q`, acting back as `-w f`.
+///
+/// A gear mesh between two shafts with radii `r1`, `r2` is one element with weights
+/// `(r1, r2)` (or `(1, -i)` for a transmission ratio i); a 1-DOF model has weight 1.
+#[derive(Debug)]
+pub struct Element {
+    pub(crate) name: String,
+    pub(crate) weights: Vec<(usize, f64)>,
+    pub(crate) law: Box<dyn ForceLaw>,
+    pub(crate) linear: LinearPart,
+}
+
+impl Element {
+    /// The element's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Its weights as `(DOF index, w_i)`.
+    pub fn weights(&self) -> &[(usize, f64)] {
+        &self.weights
+    }
+
+    /// Its force law.
+    pub fn law(&self) -> &dyn ForceLaw {
+        self.law.as_ref()
+    }
+
+    /// Its constant linear part `(k0, d0)`.
+    pub fn linear_part(&self) -> LinearPart {
+        self.linear
+    }
+
+    /// `u = w·x` for a vector `x` indexed by DOF.
+    #[inline]
+    pub fn gather<T>(&self, x: &[T]) -> T
+    where
+        T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T> + Default,
+    {
+        self.weights
+            .iter()
+            .fold(T::default(), |acc, &(i, w)| acc + x[i] * w)
+    }
+
+    /// `out += w f`.
+    #[inline]
+    pub fn scatter_add<T>(&self, f: T, out: &mut [T])
+    where
+        T: Copy + std::ops::Mul<f64, Output = T> + std::ops::AddAssign,
+    {
+        for &(i, w) in &self.weights {
+            out[i] += f * w;
+        }
+    }
+
+    /// `a += s w wᵀ`.
+    pub(crate) fn add_outer(&self, a: &mut DMatrix<f64>, s: f64) {
+        for &(i, wi) in &self.weights {
+            for &(j, wj) in &self.weights {
+                a[(i, j)] += s * wi * wj;
+            }
+        }
+    }
+}

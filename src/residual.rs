@@ -1,0 +1,262 @@
+//! The harmonic-balance problem: `R(Q) = Z(Ω) Q + F_rest(Q) - F_ext = 0`.
+//!
+//! For every harmonic `k`, `Z_k = -(kΩ)² M + i kΩ D0 + K0` is the paper's dynamic stiffness
+//! (eq. 2) with the constant split `K0`, `D0` ([`Model::k0`], [`Model::d0`]). The rest
+//! `F_rest(Q)` collects, per element, `w (f(θ, u, u̇) - k0 u - d0 u̇)` with `u = w·q`: the paper's
+//! `D1(t) q̇ + K1(t) q` and any nonlinearity. It is evaluated by AFT: the element's local
+//! harmonics `U_k = w·Q_k` are synthesised to `u(θ_j)`, `u̇(θ_j)` at the N samples, the force is
+//! evaluated there, and an FFT brings it back (three real FFTs per time-varying element,
+//! whatever the number of DOFs). Elements that are linear and time-invariant cost nothing.
+
+use crate::error::{Error, Result};
+use crate::harmonic::{AftPlan, AftScratch, DynamicStiffness, HarmonicBasis};
+use crate::model::Model;
+use crate::solution::SolveStats;
+use num_complex::Complex64;
+use std::f64::consts::TAU;
+
+/// A model discretised on a harmonic basis: AFT plan, factored `Z_k`, load harmonics.
+///
+/// Build it once per (model, Ω, H, N) and reuse it for any number of solves; every solve needs
+/// a [`Workspace`] from [`HarmonicBalance::workspace`].
+#[derive(Debug)]
+pub struct HarmonicBalance<'m> {
+    model: &'m Model,
+    basis: HarmonicBasis,
+    aft: AftPlan,
+    z: DynamicStiffness,
+    f_ext: Vec<Complex64>,
+    active: Vec<ActiveElement>,
+    thetas: Vec<f64>,
+}
+
+/// A time-varying or nonlinear element and the samples that sit on its time jumps.
+#[derive(Debug, Clone)]
+struct ActiveElement {
+    index: usize,
+    jump_samples: Vec<usize>,
+}
+
+/// Buffers of one AFT pass and its work counters.
+#[derive(Debug, Clone)]
+pub struct AftBuffers {
+    aft: AftScratch,
+    uk: Vec<Complex64>,
+    u: Vec<f64>,
+    du: Vec<f64>,
+    f: Vec<f64>,
+    /// Real FFTs done so far.
+    pub ffts: usize,
+    /// Force-law calls so far.
+    pub force_evaluations: usize,
+}
+
+/// Per-solve buffers: no allocation happens while iterating.
+#[derive(Debug, Clone)]
+pub struct Workspace {
+    pub(crate) eval: AftBuffers,
+    pub(crate) q: Vec<Complex64>,
+    pub(crate) rest: Vec<Complex64>,
+    pub(crate) rhs: Vec<Complex64>,
+    pub(crate) zq: Vec<Complex64>,
+    pub(crate) stats: SolveStats,
+}
+
+impl<'m> HarmonicBalance<'m> {
+    /// Discretises `model` on `basis`: plans the FFTs, factors `Z_k` for `k = 0..=H`.
+    ///
+    /// Errors: a load order above H, or a singular `Z_k` (undamped resonance at a harmonic, or a
+    /// rigid-body mode at k = 0).
+    pub fn new(model: &'m Model, basis: HarmonicBasis) -> Result<Self> {
+        let (n, h) = (model.n_dofs(), basis.harmonics());
+        if basis.samples() < 2 * h + 1 {
+            return Err(Error::TooFewSamples {
+                harmonics: h,
+                samples: basis.samples(),
+            });
+        }
+        let mut f_ext = vec![Complex64::default(); (h + 1) * n];
+        for l in model.loads() {
+            if l.order > h {
+                return Err(Error::LoadOrderTooHigh {
+                    dof: model.dof_names()[l.dof].clone(),
+                    order: l.order,
+                    harmonics: h,
+                });
+            }
+            f_ext[l.order * n + l.dof] += crate::harmonic::from_cos_sin(l.cos, l.sin);
+        }
+        let z = DynamicStiffness::new(&basis, model.mass(), &model.d0(), &model.k0())?;
+        let samples = basis.samples();
+        let thetas: Vec<f64> = (0..samples).map(|j| basis.theta(j)).collect();
+        let active = model
+            .elements()
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| !e.law().is_linear_time_invariant())
+            .map(|(index, e)| {
+                let mut jump_samples: Vec<usize> = e
+                    .law()
+                    .time_breakpoints()
+                    .iter()
+                    .filter_map(|&b| {
+                        let x = b / TAU * samples as f64;
+                        let j = x.round();
+                        ((x - j).abs() < 1e-9).then_some(j as usize % samples)
+                    })
+                    .collect();
+                jump_samples.sort_unstable();
+                jump_samples.dedup();
+                ActiveElement {
+                    index,
+                    jump_samples,
+                }
+            })
+            .collect();
+        Ok(Self {
+            model,
+            basis,
+            aft: AftPlan::new(basis),
+            z,
+            f_ext,
+            active,
+            thetas,
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &'m Model {
+        self.model
+    }
+
+    /// The harmonic basis.
+    pub fn basis(&self) -> &HarmonicBasis {
+        &self.basis
+    }
+
+    /// The AFT plan.
+    pub fn aft(&self) -> &AftPlan {
+        &self.aft
+    }
+
+    /// The factored dynamic stiffness.
+    pub fn dynamic_stiffness(&self) -> &DynamicStiffness {
+        &self.z
+    }
+
+    /// Load harmonics `F_ext` ((H+1)·n, harmonic-major).
+    pub fn external_load(&self) -> &[Complex64] {
+        &self.f_ext
+    }
+
+    /// Length of a harmonic vector, (H+1)·n.
+    pub fn len(&self) -> usize {
+        (self.basis.harmonics() + 1) * self.model.n_dofs()
+    }
+
+    /// `true` if there are no unknowns (never: a model has at least one DOF).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Buffers for one solve at a time.
+    pub fn workspace(&self) -> Workspace {
+        let (h, n, s) = (
+            self.basis.harmonics(),
+            self.model.n_dofs(),
+            self.basis.samples(),
+        );
+        let len = (h + 1) * n;
+        Workspace {
+            eval: AftBuffers {
+                aft: self.aft.make_scratch(),
+                uk: vec![Complex64::default(); h + 1],
+                u: vec![0.0; s],
+                du: vec![0.0; s],
+                f: vec![0.0; s],
+                ffts: 0,
+                force_evaluations: 0,
+            },
+            q: vec![Complex64::default(); len],
+            rest: vec![Complex64::default(); len],
+            rhs: vec![Complex64::default(); len],
+            zq: vec![Complex64::default(); len],
+            stats: SolveStats::default(),
+        }
+    }
+
+    /// `out ← F_rest(Q)` by AFT. Error if a force turns non-finite (names the element).
+    pub fn rest_into(
+        &self,
+        q: &[Complex64],
+        out: &mut [Complex64],
+        ws: &mut AftBuffers,
+    ) -> Result<()> {
+        let (n, h) = (self.model.n_dofs(), self.basis.harmonics());
+        let omega = self.basis.omega();
+        out.fill(Complex64::default());
+        for act in &self.active {
+            let e = &self.model.elements()[act.index];
+            for k in 0..=h {
+                ws.uk[k] = e.gather(&q[k * n..(k + 1) * n]);
+            }
+            self.aft
+                .synthesize_into(&ws.uk, |_| Complex64::new(1.0, 0.0), &mut ws.u, &mut ws.aft);
+            self.aft.synthesize_into(
+                &ws.uk,
+                |k| Complex64::new(0.0, k as f64 * omega),
+                &mut ws.du,
+                &mut ws.aft,
+            );
+            let law = e.law();
+            let lin = e.linear_part();
+            for (j, ((f, &u), &du)) in ws.f.iter_mut().zip(&ws.u).zip(&ws.du).enumerate() {
+                *f = law.force(self.thetas[j], u, du) - lin.stiffness * u - lin.damping * du;
+            }
+            // A sample on a time jump takes the mean of both one-sided limits.
+            let delta = 1e-7 * TAU / self.basis.samples() as f64;
+            for &j in &act.jump_samples {
+                let (t, u, du) = (self.thetas[j], ws.u[j], ws.du[j]);
+                let mean = 0.5 * (law.force(t - delta, u, du) + law.force(t + delta, u, du));
+                ws.f[j] = mean - lin.stiffness * u - lin.damping * du;
+            }
+            ws.force_evaluations += self.basis.samples() + 2 * act.jump_samples.len();
+            if !ws.f.iter().all(|v| v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: format!("force of element `{}`", e.name()),
+                });
+            }
+            self.aft.analyze_into(&mut ws.f, &mut ws.uk, &mut ws.aft);
+            ws.ffts += 3;
+            for k in 0..=h {
+                e.scatter_add(ws.uk[k], &mut out[k * n..(k + 1) * n]);
+            }
+        }
+        Ok(())
+    }
+
+    /// `r ← R(Q) = Z Q + F_rest(Q) - F_ext`.
+    pub fn residual_into(&self, q: &[Complex64], r: &mut [Complex64], ws: &mut Workspace) -> Result<()> {
+        self.rest_into(q, &mut ws.rest, &mut ws.eval)?;
+        let n = self.model.n_dofs();
+        for k in 0..=self.basis.harmonics() {
+            let s = k * n..(k + 1) * n;
+            self.z.apply(k, &q[s.clone()], &mut r[s.clone()]);
+            for i in s {
+                r[i] += ws.rest[i] - self.f_ext[i];
+            }
+        }
+        Ok(())
+    }
+
+    /// Parseval norm `sqrt(Σ_i [|X_0i|² + ½ Σ_k |X_ki|²])`: the RMS over one period, summed
+    /// over DOFs.
+    pub fn norm(&self, x: &[Complex64]) -> f64 {
+        let n = self.model.n_dofs();
+        let mut s = 0.0;
+        for (idx, v) in x.iter().enumerate() {
+            s += if idx < n { v.norm_sqr() } else { 0.5 * v.norm_sqr() };
+        }
+        s.sqrt()
+    }
+}

@@ -1,0 +1,167 @@
+//! The result of a solve: harmonics per DOF, termination, residual history and statistics.
+
+use crate::harmonic::{cos_sin, HarmonicBasis};
+use num_complex::Complex64;
+use std::time::Duration;
+
+/// Why an iteration stopped. Only [`Termination::Converged`] means the tolerance was met; in
+/// every case the [`Solution`] holds the last finite iterate.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// The relative residual fell below the tolerance.
+    Converged,
+    /// The iteration limit was reached first.
+    MaxIterations,
+    /// The residual grew by more than the divergence factor over its best value: the fixed-point
+    /// map is not a contraction here (raise γ, or use an accelerated solver).
+    Diverged,
+    /// A force or linear solve produced NaN or infinity.
+    NonFinite {
+        /// What turned non-finite.
+        what: String,
+    },
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Termination::Converged => write!(f, "converged"),
+            Termination::MaxIterations => write!(f, "maximum iterations reached"),
+            Termination::Diverged => write!(f, "diverged"),
+            Termination::NonFinite { what } => write!(f, "non-finite value in {what}"),
+        }
+    }
+}
+
+/// Counts of the work a solve did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct SolveStats {
+    /// Solver iterations (linear solves of all harmonics).
+    pub iterations: usize,
+    /// Residual evaluations (AFT passes).
+    pub residual_evaluations: usize,
+    /// Real FFTs of length N.
+    pub ffts: usize,
+    /// Calls of [`ForceLaw::force`](crate::force::ForceLaw::force).
+    pub force_evaluations: usize,
+}
+
+/// A periodic solution `q(θ) = Re Σ_k Q_k e^{ikθ}`, `θ = Ω t`, with how it was obtained.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct Solution {
+    pub(crate) basis: HarmonicBasis,
+    pub(crate) dofs: Vec<String>,
+    /// `Q[k * n + i]`, harmonic-major.
+    pub(crate) harmonics: Vec<Complex64>,
+    /// Why the solve stopped.
+    pub termination: Termination,
+    /// Relative residual `‖R(Q)‖ / ‖F_ext‖` (Parseval norms; without a load
+    /// `‖R‖ / max(‖Z Q‖, ‖F_rest‖)`) of every iterate, starting with the initial guess.
+    pub history: Vec<f64>,
+    /// Work counts.
+    pub stats: SolveStats,
+    /// Wall time of the solve (plans built beforehand).
+    pub wall_time: Duration,
+}
+
+impl Solution {
+    /// `true` if the tolerance was met.
+    pub fn is_converged(&self) -> bool {
+        self.termination == Termination::Converged
+    }
+
+    /// The harmonic basis.
+    pub fn basis(&self) -> &HarmonicBasis {
+        &self.basis
+    }
+
+    /// DOF names.
+    pub fn dof_names(&self) -> &[String] {
+        &self.dofs
+    }
+
+    /// All harmonics, harmonic-major (`Q[k * n + i]`).
+    pub fn harmonics(&self) -> &[Complex64] {
+        &self.harmonics
+    }
+
+    /// The last relative residual.
+    pub fn residual(&self) -> f64 {
+        self.history.last().copied().unwrap_or(f64::NAN)
+    }
+
+    /// Complex harmonic `Q_k` of DOF `dof` (`a_k - i b_k`); zero above H.
+    pub fn harmonic(&self, dof: usize, k: usize) -> Complex64 {
+        if k > self.basis.harmonics() {
+            return Complex64::default();
+        }
+        self.harmonics[k * self.dofs.len() + dof]
+    }
+
+    /// `(a_k, b_k)` of `a_k cos kθ + b_k sin kθ` for DOF `dof`.
+    pub fn cos_sin(&self, dof: usize, k: usize) -> (f64, f64) {
+        cos_sin(self.harmonic(dof, k))
+    }
+
+    /// `q_dof(θ)` at angle `θ = Ω t`.
+    pub fn displacement(&self, dof: usize, theta: f64) -> f64 {
+        (0..=self.basis.harmonics())
+            .map(|k| (self.harmonic(dof, k) * Complex64::from_polar(1.0, k as f64 * theta)).re)
+            .sum()
+    }
+
+    /// `q̇_dof(θ)` at angle `θ = Ω t`.
+    pub fn velocity(&self, dof: usize, theta: f64) -> f64 {
+        let w = self.basis.omega();
+        (1..=self.basis.harmonics())
+            .map(|k| {
+                (self.harmonic(dof, k)
+                    * Complex64::new(0.0, k as f64 * w)
+                    * Complex64::from_polar(1.0, k as f64 * theta))
+                .re
+            })
+            .sum()
+    }
+
+    /// `q_dof` at `points` equidistant angles over one period, starting at θ = 0.
+    pub fn time_series(&self, dof: usize, points: usize) -> Vec<f64> {
+        (0..points)
+            .map(|j| self.displacement(dof, std::f64::consts::TAU * j as f64 / points as f64))
+            .collect()
+    }
+
+    /// `max |q_dof|` over one period (sampled at 8N points).
+    pub fn max_abs(&self, dof: usize) -> f64 {
+        self.time_series(dof, 8 * self.basis.samples())
+            .into_iter()
+            .fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    /// Truncation-error estimate: the RMS of the top quarter of the kept harmonics
+    /// (`k > H - ⌈H/4⌉`) relative to the RMS of the whole oscillating part (`k >= 1`), over all
+    /// DOFs. A spectrum that is resolved decays, so this is small; near 1 means H is too low.
+    pub fn truncation_estimate(&self) -> f64 {
+        let (n, h) = (self.dofs.len(), self.basis.harmonics());
+        if h == 0 {
+            return 0.0;
+        }
+        let top = h - h.div_ceil(4);
+        let (mut tail, mut all) = (0.0, 0.0);
+        for k in 1..=h {
+            let e: f64 = self.harmonics[k * n..(k + 1) * n]
+                .iter()
+                .map(|v| v.norm_sqr())
+                .sum();
+            all += e;
+            if k > top {
+                tail += e;
+            }
+        }
+        if all == 0.0 {
+            0.0
+        } else {
+            (tail / all).sqrt()
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Time-domain reference (todo)
