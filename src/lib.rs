@@ -44,10 +44,13 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod catalog;
+pub mod compare;
 pub mod error;
 pub mod force;
 pub mod harmonic;
 pub mod model;
+pub mod report;
 pub mod residual;
 pub mod solution;
 pub mod solve;

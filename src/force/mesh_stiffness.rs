@@ -1,7 +1,7 @@
 //! `mesh_stiffness`: a periodically varying gear-mesh stiffness and damping,
 //! `f = k(φ) u + d(φ) u̇` with mesh angle `φ = z θ + φ0`.
 
-use super::profile::jump_angles;
+use super::profile::{cycle_fraction, jump_angles};
 use super::{ForceLaw, LinearPart, MeshDamping, MeshProfile};
 use crate::error::{check_finite, Error, Result};
 
@@ -66,6 +66,38 @@ impl ForceLaw for MeshStiffness {
     fn force(&self, theta: f64, u: f64, du: f64) -> f64 {
         let k = self.stiffness_at(theta);
         k * u + self.damping.value(k) * du
+    }
+    fn force_batch(&self, theta: &[f64], u: &[f64], du: &[f64], out: &mut [f64]) {
+        let z = self.teeth as f64;
+        let samples = out.iter_mut().zip(theta).zip(u).zip(du);
+        match (&self.profile, self.damping) {
+            (
+                MeshProfile::Rectangular {
+                    one_tooth,
+                    two_tooth,
+                    contact_ratio,
+                },
+                damping,
+            ) => {
+                let two = (*two_tooth, damping.value(*two_tooth));
+                let one = (*one_tooth, damping.value(*one_tooth));
+                let edge = contact_ratio - 1.0;
+                for (((o, &t), &x), &v) in samples {
+                    let (k, d) = if cycle_fraction(z * t + self.phase) < edge {
+                        two
+                    } else {
+                        one
+                    };
+                    *o = k * x + d * v;
+                }
+            }
+            (profile, damping) => {
+                for (((o, &t), &x), &v) in samples {
+                    let k = profile.value(z * t + self.phase);
+                    *o = k * x + damping.value(k) * v;
+                }
+            }
+        }
     }
     #[inline]
     fn derivatives(&self, theta: f64, _u: f64, _du: f64) -> (f64, f64) {

@@ -71,6 +71,16 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
     /// The restoring force `f(θ, u, u̇)`.
     fn force(&self, theta: f64, u: f64, du: f64) -> f64;
 
+    /// The force at many samples: `out[j] = f(θ[j], u[j], u̇[j])`. All slices have one length.
+    ///
+    /// The AFT calls this once per element and pass; the default loops over
+    /// [`ForceLaw::force`]. Override it where a law can hoist work out of the loop.
+    fn force_batch(&self, theta: &[f64], u: &[f64], du: &[f64], out: &mut [f64]) {
+        for (((o, &t), &x), &v) in out.iter_mut().zip(theta).zip(u).zip(du) {
+            *o = self.force(t, x, v);
+        }
+    }
+
     /// The partial derivatives `(∂f/∂u, ∂f/∂u̇)` at `(θ, u, u̇)`, for Newton-type solvers.
     ///
     /// Where the law has a kink (contact), return either one-sided value.

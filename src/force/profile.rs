@@ -55,8 +55,7 @@ impl MeshProfile {
                 two_tooth,
                 contact_ratio,
             } => {
-                let m = (phi / TAU).rem_euclid(1.0);
-                if m < contact_ratio - 1.0 {
+                if cycle_fraction(phi) < contact_ratio - 1.0 {
                     *two_tooth
                 } else {
                     *one_tooth
@@ -139,6 +138,18 @@ impl MeshProfile {
                 Ok(())
             }
         }
+    }
+}
+
+/// `frac(φ / 2π)` in [0, 1), without a libm `floor` call (this sits in the AFT hot loop).
+#[inline]
+pub(crate) fn cycle_fraction(phi: f64) -> f64 {
+    let x = phi * (1.0 / TAU);
+    let m = x - (x as i64) as f64;
+    if m < 0.0 {
+        m + 1.0
+    } else {
+        m
     }
 }
 

@@ -1,0 +1,7 @@
+//! Reports: SVG plots and timing for tables.
+
+mod plot;
+mod timing;
+
+pub use plot::{line_plot, Axis, Series};
+pub use timing::median_time;

@@ -1,0 +1,164 @@
+//! SVG line plots (plotters, SVG backend only).
+
+use std::path::Path;
+
+/// One curve.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend label.
+    pub label: String,
+    /// Points `(x, y)`.
+    pub points: Vec<(f64, f64)>,
+    /// Draw markers instead of a line.
+    pub markers: bool,
+}
+
+impl Series {
+    /// A line.
+    pub fn line(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            label: label.into(),
+            points,
+            markers: false,
+        }
+    }
+
+    /// Markers only.
+    pub fn markers(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            label: label.into(),
+            points,
+            markers: true,
+        }
+    }
+}
+
+/// An axis: label and whether it is logarithmic.
+#[derive(Debug, Clone)]
+pub struct Axis {
+    /// Label.
+    pub label: String,
+    /// Logarithmic scale (non-positive values are dropped).
+    pub log: bool,
+}
+
+impl Axis {
+    /// A linear axis.
+    pub fn linear(label: impl Into<String>) -> Self {
+        Self {
+            label: label.into(),
+            log: false,
+        }
+    }
+
+    /// A logarithmic axis.
+    pub fn log(label: impl Into<String>) -> Self {
+        Self {
+            label: label.into(),
+            log: true,
+        }
+    }
+}
+
+const COLORS: [plotters::style::RGBColor; 6] = [
+    plotters::style::RGBColor(0, 0, 0),
+    plotters::style::RGBColor(214, 39, 40),
+    plotters::style::RGBColor(31, 119, 180),
+    plotters::style::RGBColor(44, 160, 44),
+    plotters::style::RGBColor(148, 103, 189),
+    plotters::style::RGBColor(255, 127, 14),
+];
+
+/// Writes an SVG with the given curves to `path`.
+pub fn line_plot(
+    path: &Path,
+    title: &str,
+    x: &Axis,
+    y: &Axis,
+    series: &[Series],
+) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::prelude::*;
+    let keep = |a: &Axis, v: f64| v.is_finite() && (!a.log || v > 0.0);
+    let pts: Vec<Vec<(f64, f64)>> = series
+        .iter()
+        .map(|s| {
+            s.points
+                .iter()
+                .copied()
+                .filter(|&(px, py)| keep(x, px) && keep(y, py))
+                .collect()
+        })
+        .collect();
+    let all = pts.iter().flatten();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(px, py) in all {
+        x0 = x0.min(px);
+        x1 = x1.max(px);
+        y0 = y0.min(py);
+        y1 = y1.max(py);
+    }
+    if x0 > x1 {
+        return Err("nothing to plot".into());
+    }
+    let pad = |lo: f64, hi: f64, log: bool| {
+        if log {
+            (lo / 1.5, hi * 1.5)
+        } else if hi > lo {
+            let d = 0.05 * (hi - lo);
+            (lo - d, hi + d)
+        } else {
+            (lo - 1.0, hi + 1.0)
+        }
+    };
+    let (x0, x1) = pad(x0, x1, x.log);
+    let (y0, y1) = pad(y0, y1, y.log);
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    macro_rules! draw {
+        ($chart:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .x_desc(x.label.as_str())
+                .y_desc(y.label.as_str())
+                .draw()?;
+            for (i, (s, p)) in series.iter().zip(&pts).enumerate() {
+                let color = COLORS[i % COLORS.len()];
+                if s.markers {
+                    chart
+                        .draw_series(p.iter().map(|&c| Circle::new(c, 3, color.filled())))?
+                        .label(s.label.as_str())
+                        .legend(move |(lx, ly)| Circle::new((lx + 10, ly), 3, color.filled()));
+                } else {
+                    chart
+                        .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))?
+                        .label(s.label.as_str())
+                        .legend(move |(lx, ly)| {
+                            PathElement::new(vec![(lx, ly), (lx + 20, ly)], color.stroke_width(2))
+                        });
+                }
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()?;
+        }};
+    }
+    let mut builder = ChartBuilder::on(&root);
+    builder
+        .caption(title, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(80);
+    match (x.log, y.log) {
+        (false, false) => draw!(builder.build_cartesian_2d(x0..x1, y0..y1)?),
+        (false, true) => draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?),
+        (true, false) => draw!(builder.build_cartesian_2d((x0..x1).log_scale(), y0..y1)?),
+        (true, true) => {
+            draw!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?)
+        }
+    }
+    root.present()?;
+    Ok(())
+}

@@ -1,0 +1,104 @@
+//! The first-order right-hand side `y = (q, q̇)`, `ẏ = (q̇, M⁻¹(f - D q̇ - K q - Σ w f_e))`.
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use differential_equations::prelude::*;
+use nalgebra::{Cholesky, DVector, Dyn};
+use std::cell::{Cell, RefCell};
+
+pub(super) struct Rhs<'m> {
+    model: &'m Model,
+    chol: Cholesky<f64, Dyn>,
+    omega: f64,
+    /// (t_a, θ_a, θ_lo, θ_hi) of the current segment.
+    segment: Cell<(f64, f64, f64, f64)>,
+    acc: RefCell<DVector<f64>>,
+}
+
+impl<'m> Rhs<'m> {
+    pub(super) fn new(model: &'m Model, omega: f64) -> Result<Self> {
+        let chol = model
+            .mass()
+            .clone()
+            .cholesky()
+            .ok_or_else(|| Error::MassNotPositiveDefinite {
+                reason: "Cholesky factorisation failed".into(),
+            })?;
+        Ok(Self {
+            model,
+            chol,
+            omega,
+            segment: Cell::new((0.0, 0.0, 0.0, std::f64::consts::TAU)),
+            acc: RefCell::new(DVector::zeros(model.n_dofs())),
+        })
+    }
+
+    /// The next calls see angles `θ = θ_a + Ω (t - t_a)` clamped inside `[θ_a, θ_b]`, so the
+    /// laws take their values from inside the segment even at its ends.
+    pub(super) fn enter_segment(&self, t_a: f64, theta_a: f64, theta_b: f64) {
+        let delta = 1e-9 * (theta_b - theta_a);
+        self.segment
+            .set((t_a, theta_a, theta_a + delta, theta_b - delta));
+    }
+}
+
+impl ODE<f64, Vec<f64>> for Rhs<'_> {
+    fn diff(&self, t: f64, y: &Vec<f64>, dydt: &mut Vec<f64>) {
+        let n = self.model.n_dofs();
+        let (q, v) = y.split_at(n);
+        let (ta, tha, lo, hi) = self.segment.get();
+        let theta = (tha + self.omega * (t - ta)).clamp(lo, hi);
+        let mut a = self.acc.borrow_mut();
+        a.fill(0.0);
+        self.model.load_into(theta, a.as_mut_slice());
+        let (d, k) = (
+            self.model.structural_damping(),
+            self.model.structural_stiffness(),
+        );
+        for i in 0..n {
+            let mut s = 0.0;
+            for j in 0..n {
+                s += d[(i, j)] * v[j] + k[(i, j)] * q[j];
+            }
+            a[i] -= s;
+        }
+        for e in self.model.elements() {
+            let f = e.law().force(theta, e.gather(q), e.gather(v));
+            e.scatter_add(-f, a.as_mut_slice());
+        }
+        self.chol.solve_mut(&mut *a);
+        dydt[..n].copy_from_slice(v);
+        dydt[n..].copy_from_slice(a.as_slice());
+    }
+}
+
+/// Keeps only the point at the end of the interval.
+pub(super) struct LastPoint {
+    t_end: f64,
+}
+
+impl LastPoint {
+    pub(super) fn new(t_end: f64) -> Self {
+        Self { t_end }
+    }
+}
+
+impl Solout<f64, Vec<f64>> for LastPoint {
+    fn solout<I>(
+        &mut self,
+        t_curr: f64,
+        _t_prev: f64,
+        y_curr: &Vec<f64>,
+        _y_prev: &Vec<f64>,
+        _interpolator: &mut I,
+        solution: &mut Solution<f64, Vec<f64>>,
+    ) -> ControlFlag<f64, Vec<f64>>
+    where
+        I: Interpolation<f64, Vec<f64>> + ?Sized,
+    {
+        if t_curr >= self.t_end - 1e-12 * self.t_end.abs().max(1.0) {
+            solution.push(t_curr, y_curr.clone());
+        }
+        ControlFlag::Continue
+    }
+}
