@@ -62,6 +62,13 @@ pub struct Workspace {
     pub(crate) stats: SolveStats,
 }
 
+impl Workspace {
+    /// The AFT buffers, for calling [`HarmonicBalance::rest_into`] directly.
+    pub fn aft_buffers(&mut self) -> &mut AftBuffers {
+        &mut self.eval
+    }
+}
+
 impl<'m> HarmonicBalance<'m> {
     /// Discretises `model` on `basis`: plans the FFTs, factors `Z_k` for `k = 0..=H`.
     ///
@@ -185,7 +192,7 @@ impl<'m> HarmonicBalance<'m> {
         }
     }
 
-    /// `out ← F_rest(Q)` by AFT. Error if a force turns non-finite (names the element).
+    /// `out ← F_rest(Q)` by AFT (use [`Workspace::aft_buffers`] for `ws`). Error if a force turns non-finite (names the element).
     pub fn rest_into(
         &self,
         q: &[Complex64],

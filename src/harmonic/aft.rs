@@ -78,9 +78,8 @@ impl AftPlan {
         for k in 1..=h {
             s.spectrum[k] = harmonics[k] * scale(k) * 0.5;
         }
-        // Keep the Nyquist bin real, as the inverse transform requires (H < N/2 always).
-        let last = s.spectrum.len() - 1;
-        s.spectrum[last].im = 0.0;
+        // For even N the last bin is the Nyquist bin, which must be real; N >= 2H+1 keeps it
+        // empty. For odd N it is an ordinary harmonic.
         // The only error realfft reports is a wrong buffer length, ruled out by construction.
         let _ = self
             .inverse
