@@ -1,1 +1,67 @@
-fn main(){}
+//! Performance targets of issue 2 (medians; compare ratios within one run):
+//! - two-shaft at 6000 rpm, H = 32, 3 fixed-point iterations, plans built beforehand: <= 20 µs;
+//! - HB cost flat across speed: 60000 rpm within 2x of 60 rpm;
+//! - speed-up over the time-domain reference at the same error at 60000 rpm.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use hbal::catalog::TwoShaft;
+use hbal::timesim::TimeSimulation;
+use hbal::{FixedPoint, HarmonicBalance, HarmonicBasis};
+use std::hint::black_box;
+use std::time::Duration;
+
+fn three_iterations(c: &mut Criterion) {
+    let case = TwoShaft::new(6000.0);
+    let model = case.model().unwrap();
+    let hb =
+        HarmonicBalance::new(&model, HarmonicBasis::new(case.mesh_omega(), 32).unwrap()).unwrap();
+    let mut ws = hb.workspace();
+    let solver = FixedPoint::new()
+        .with_tolerance(0.0)
+        .unwrap()
+        .with_max_iterations(3);
+    c.bench_function("two_shaft_6000rpm_H32_3_iterations", |b| {
+        b.iter(|| black_box(solver.solve(&hb, &mut ws).unwrap()))
+    });
+}
+
+fn flat_across_speed(c: &mut Criterion) {
+    let mut group = c.benchmark_group("hb_converged_H32");
+    for rpm in [60.0, 600.0, 60000.0] {
+        let case = TwoShaft::new(rpm);
+        let model = case.model().unwrap();
+        let hb = HarmonicBalance::new(&model, HarmonicBasis::new(case.mesh_omega(), 32).unwrap())
+            .unwrap();
+        let mut ws = hb.workspace();
+        let solver = FixedPoint::new();
+        assert!(solver.solve(&hb, &mut ws).unwrap().is_converged());
+        group.bench_with_input(BenchmarkId::from_parameter(rpm), &rpm, |b, _| {
+            b.iter(|| black_box(solver.solve(&hb, &mut ws).unwrap()))
+        });
+    }
+    group.finish();
+}
+
+fn time_domain(c: &mut Criterion) {
+    let mut group = c.benchmark_group("time_domain_to_1e-6");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(3));
+    for rpm in [60.0, 600.0, 6000.0, 60000.0] {
+        let case = TwoShaft::new(rpm);
+        let model = case.model().unwrap();
+        let sim = TimeSimulation {
+            rtol: 1e-8,
+            steady_tolerance: 1e-6,
+            samples: 256,
+            ..TimeSimulation::default()
+        };
+        group.bench_with_input(BenchmarkId::from_parameter(rpm), &rpm, |b, _| {
+            b.iter(|| black_box(sim.run(&model, case.mesh_omega()).unwrap()))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, three_iterations, flat_across_speed, time_domain);
+criterion_main!(benches);

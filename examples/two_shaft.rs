@@ -52,7 +52,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut errs = Vec::new();
         let mut iterates = Vec::new();
         for it in 1..=4 {
-            let solver = FixedPoint::new().with_tolerance(0.0)?.with_max_iterations(it);
+            let solver = FixedPoint::new()
+                .with_tolerance(0.0)?
+                .with_max_iterations(it);
             let (wall, sol) = median_time(budget, || solver.solve(&hb, &mut ws));
             let sol = sol?;
             walls.push(wall);
@@ -76,7 +78,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // Converged run: the paper's γ = 0 if it converges, else relaxation γ = 0.5.
         let mut conv = None;
         for gamma in [0.0, 0.5] {
-            let solver = FixedPoint::new().with_gamma(gamma)?.with_max_iterations(2000);
+            let solver = FixedPoint::new()
+                .with_gamma(gamma)?
+                .with_max_iterations(2000);
             let (wall, sol) = median_time(budget, || solver.solve(&hb, &mut ws));
             let sol = sol?;
             let first = sol.termination.clone();
@@ -151,7 +155,9 @@ fn speed_up_table(budget: Duration) -> Result<(), Box<dyn std::error::Error>> {
             let hb = HarmonicBalance::new(&model, basis)?;
             let mut ws = hb.workspace();
             for gamma in [0.0, 0.5] {
-                let solver = FixedPoint::new().with_gamma(gamma)?.with_max_iterations(2000);
+                let solver = FixedPoint::new()
+                    .with_gamma(gamma)?
+                    .with_max_iterations(2000);
                 let (wall, sol) = median_time(budget, || solver.solve(&hb, &mut ws));
                 let sol = sol?;
                 if sol.termination != Termination::Converged {
@@ -169,7 +175,7 @@ fn speed_up_table(budget: Duration) -> Result<(), Box<dyn std::error::Error>> {
         }
         match row {
             Some((h, gamma, wall, sol, err)) => println!(
-                "| {rpm} | {} | {} | {td_err:.2e} | {h} | {} | {} ({gamma}) | {err:.2e} | {:.0}x |",
+                "| {rpm} | {} | {} | {td_err:.2e} | {h} | {} | {} ({gamma}) | {err:.2e} | {:.2}x |",
                 fmt(td_wall),
                 td.periods,
                 fmt(wall),

@@ -170,7 +170,11 @@ impl Duffing {
         Model::builder(&["x"])
             .mass_diagonal(&[self.m])
             .damping(DMatrix::from_element(1, 1, self.c))
-            .element("spring", &[("x", 1.0)], CubicSpring::new(self.k, self.alpha))
+            .element(
+                "spring",
+                &[("x", 1.0)],
+                CubicSpring::new(self.k, self.alpha),
+            )
             .load("x", 1, self.force, 0.0)
             .build()
     }

@@ -36,7 +36,15 @@
 //!     .load("gear", 1, 1e-3 * 5e-4 * omega_mesh * omega_mesh, 0.0)
 //!     .build()?;
 //! let hb = HarmonicBalance::new(&model, HarmonicBasis::new(omega_mesh, 32)?)?;
-//! let solution = FixedPoint::new().solve(&hb, &mut hb.workspace())?;
+//! // The paper's undamped iteration (γ = 0) diverges at this speed: mesh harmonics sit on the
+//! // natural frequencies. That is a termination, not an error or a NaN:
+//! let undamped = FixedPoint::new().solve(&hb, &mut hb.workspace())?;
+//! assert_eq!(undamped.termination, hbal::Termination::Diverged);
+//! // The paper's damping factor γ makes it converge:
+//! let solution = FixedPoint::new()
+//!     .with_gamma(0.5)?
+//!     .with_max_iterations(1000)
+//!     .solve(&hb, &mut hb.workspace())?;
 //! assert!(solution.is_converged());
 //! // Static part: L0 / K_mean = 10 / 3.75e5 (the mesh variation shifts it a little).
 //! assert!((solution.cos_sin(0, 0).0 - 2.99e-5).abs() < 1e-7);
@@ -60,5 +68,10 @@ pub use error::{Error, Result};
 pub use harmonic::HarmonicBasis;
 pub use model::{Element, Model};
 pub use residual::{AftBuffers, HarmonicBalance, Workspace};
-pub use solution::{SolveStats, Solution, Termination};
+pub use solution::{Solution, SolveStats, Termination};
 pub use solve::FixedPoint;
+
+/// The README's code blocks run as doctests, so the README stays true.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -244,7 +244,12 @@ impl<'m> HarmonicBalance<'m> {
     }
 
     /// `r ← R(Q) = Z Q + F_rest(Q) - F_ext`.
-    pub fn residual_into(&self, q: &[Complex64], r: &mut [Complex64], ws: &mut Workspace) -> Result<()> {
+    pub fn residual_into(
+        &self,
+        q: &[Complex64],
+        r: &mut [Complex64],
+        ws: &mut Workspace,
+    ) -> Result<()> {
         self.rest_into(q, &mut ws.rest, &mut ws.eval)?;
         let n = self.model.n_dofs();
         for k in 0..=self.basis.harmonics() {
@@ -263,7 +268,11 @@ impl<'m> HarmonicBalance<'m> {
         let n = self.model.n_dofs();
         let mut s = 0.0;
         for (idx, v) in x.iter().enumerate() {
-            s += if idx < n { v.norm_sqr() } else { 0.5 * v.norm_sqr() };
+            s += if idx < n {
+                v.norm_sqr()
+            } else {
+                0.5 * v.norm_sqr()
+            };
         }
         s.sqrt()
     }

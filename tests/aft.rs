@@ -9,7 +9,9 @@ fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
     let mut s = seed;
     (0..n)
         .map(|_| {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
         })
         .collect()
@@ -22,7 +24,9 @@ fn round_trip_and_parseval() {
         let plan = AftPlan::new(basis);
         let mut s = plan.make_scratch();
         let r = pseudo_random(2 * h + 2, h as u64);
-        let mut q: Vec<Complex64> = (0..=h).map(|k| Complex64::new(r[2 * k], r[2 * k + 1])).collect();
+        let mut q: Vec<Complex64> = (0..=h)
+            .map(|k| Complex64::new(r[2 * k], r[2 * k + 1]))
+            .collect();
         q[0].im = 0.0;
         let mut x = vec![0.0; n];
         plan.synthesize_into(&q, |_| Complex64::new(1.0, 0.0), &mut x, &mut s);
@@ -41,7 +45,10 @@ fn round_trip_and_parseval() {
         let mut back = vec![Complex64::default(); h + 1];
         plan.analyze_into(&mut x, &mut back, &mut s);
         for k in 0..=h {
-            assert!((back[k] - q[k]).norm() < 1e-14, "round trip H {h} N {n} k {k}");
+            assert!(
+                (back[k] - q[k]).norm() < 1e-14,
+                "round trip H {h} N {n} k {k}"
+            );
         }
     }
 }
@@ -56,7 +63,12 @@ fn derivative_synthesis() {
     let mut q = vec![Complex64::default(); 5];
     q[3] = from_cos_sin(0.4, -1.1);
     let mut x = vec![0.0; basis.samples()];
-    plan.synthesize_into(&q, |k| Complex64::new(0.0, k as f64 * omega), &mut x, &mut s);
+    plan.synthesize_into(
+        &q,
+        |k| Complex64::new(0.0, k as f64 * omega),
+        &mut x,
+        &mut s,
+    );
     for (j, xj) in x.iter().enumerate() {
         let th = basis.theta(j);
         let exact = 3.0 * omega * (-0.4 * (3.0 * th).sin() - 1.1 * (3.0 * th).cos());
@@ -80,18 +92,17 @@ fn cubic_force_of_a_cosine_is_exact() {
         let mut q = vec![Complex64::default(); h + 1];
         q[1] = from_cos_sin(a, 0.0);
         let mut rest = vec![Complex64::default(); h + 1];
-        hb.rest_into(&q, &mut rest, &mut hbal_buffers(&mut ws)).unwrap();
+        hb.rest_into(&q, &mut rest, ws.aft_buffers()).unwrap();
         for (k, r) in rest.iter().enumerate() {
             let exact = match k {
                 1 => 0.75 * alpha * a.powi(3),
                 3 => 0.25 * alpha * a.powi(3),
                 _ => 0.0,
             };
-            assert!((r.re - exact).abs() < 1e-14 && r.im.abs() < 1e-14, "H {h} k {k}: {r}");
+            assert!(
+                (r.re - exact).abs() < 1e-14 && r.im.abs() < 1e-14,
+                "H {h} k {k}: {r}"
+            );
         }
     }
-}
-
-fn hbal_buffers(ws: &mut hbal::Workspace) -> &mut hbal::AftBuffers {
-    ws.aft_buffers()
 }

@@ -12,23 +12,46 @@ fn message(r: Result<Model, Error>) -> String {
 fn model_errors_name_the_place() {
     let cases: Vec<(Result<Model, Error>, &str)> = vec![
         (Model::builder(&[]).mass_diagonal(&[]).build(), "no DOFs"),
-        (Model::builder(&["a", "a"]).mass_diagonal(&[1.0, 1.0]).build(), "`a` appears twice"),
+        (
+            Model::builder(&["a", "a"])
+                .mass_diagonal(&[1.0, 1.0])
+                .build(),
+            "`a` appears twice",
+        ),
         (Model::builder(&["a"]).build(), "no mass matrix"),
-        (Model::builder(&["a"]).mass_diagonal(&[-1.0]).build(), "not symmetric positive definite"),
+        (
+            Model::builder(&["a"]).mass_diagonal(&[-1.0]).build(),
+            "not symmetric positive definite",
+        ),
         (
             Model::builder(&["a", "b"])
                 .mass(DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.0, 1.0]))
                 .build(),
             "not symmetric",
         ),
-        (Model::builder(&["a", "b"]).mass_diagonal(&[1.0]).build(), "expected 2 x 2"),
         (
-            Model::builder(&["a"]).mass_diagonal(&[1.0]).stiffness(DMatrix::from_element(1, 1, f64::NAN)).build(),
+            Model::builder(&["a", "b"]).mass_diagonal(&[1.0]).build(),
+            "expected 2 x 2",
+        ),
+        (
+            Model::builder(&["a"])
+                .mass_diagonal(&[1.0])
+                .stiffness(DMatrix::from_element(1, 1, f64::NAN))
+                .build(),
             "stiffness matrix: parameter `[0][0]` must be finite",
         ),
-        (Model::builder(&["a"]).mass_diagonal(&[1.0]).load("b", 1, 1.0, 0.0).build(), "unknown DOF `b`"),
         (
-            Model::builder(&["a"]).mass_diagonal(&[1.0]).load("a", 1, f64::INFINITY, 0.0).build(),
+            Model::builder(&["a"])
+                .mass_diagonal(&[1.0])
+                .load("b", 1, 1.0, 0.0)
+                .build(),
+            "unknown DOF `b`",
+        ),
+        (
+            Model::builder(&["a"])
+                .mass_diagonal(&[1.0])
+                .load("a", 1, f64::INFINITY, 0.0)
+                .build(),
             "parameter `cos` must be finite",
         ),
         (
@@ -48,7 +71,11 @@ fn model_errors_name_the_place() {
         (
             Model::builder(&["a"])
                 .mass_diagonal(&[1.0])
-                .element("gap", &[("a", 1.0)], Backlash::new(-0.1, MeshProfile::Constant { stiffness: 1.0 }))
+                .element(
+                    "gap",
+                    &[("a", 1.0)],
+                    Backlash::new(-0.1, MeshProfile::Constant { stiffness: 1.0 }),
+                )
                 .build(),
             "element `gap`: parameter `half_backlash` must be finite and >= 0",
         ),
@@ -60,7 +87,11 @@ fn model_errors_name_the_place() {
                     &[("a", 1.0)],
                     MeshStiffness::new(
                         4,
-                        MeshProfile::Rectangular { one_tooth: 1.0, two_tooth: 2.0, contact_ratio: 2.5 },
+                        MeshProfile::Rectangular {
+                            one_tooth: 1.0,
+                            two_tooth: 2.0,
+                            contact_ratio: 2.5,
+                        },
                         MeshDamping::Constant(0.0),
                     ),
                 )
@@ -73,7 +104,11 @@ fn model_errors_name_the_place() {
                 .element(
                     "mesh",
                     &[("a", 1.0)],
-                    MeshStiffness::new(0, MeshProfile::Constant { stiffness: 1.0 }, MeshDamping::Constant(0.0)),
+                    MeshStiffness::new(
+                        0,
+                        MeshProfile::Constant { stiffness: 1.0 },
+                        MeshDamping::Constant(0.0),
+                    ),
                 )
                 .build(),
             "parameter `teeth` must be an integer >= 1",
@@ -84,7 +119,11 @@ fn model_errors_name_the_place() {
                 .element(
                     "mesh",
                     &[("a", 1.0)],
-                    MeshStiffness::new(1, MeshProfile::Constant { stiffness: 1.0 }, MeshDamping::Proportional(f64::NAN)),
+                    MeshStiffness::new(
+                        1,
+                        MeshProfile::Constant { stiffness: 1.0 },
+                        MeshDamping::Proportional(f64::NAN),
+                    ),
                 )
                 .build(),
             "damping.proportional",
@@ -92,14 +131,21 @@ fn model_errors_name_the_place() {
         (
             Model::builder(&["a"])
                 .mass_diagonal(&[1.0])
-                .element("spring", &[("a", 1.0), ("a", 2.0)], LinearSpring::new(1.0, 0.0))
+                .element(
+                    "spring",
+                    &[("a", 1.0), ("a", 2.0)],
+                    LinearSpring::new(1.0, 0.0),
+                )
                 .build(),
             "names DOF `a` twice",
         ),
     ];
     for (result, expected) in cases {
         let msg = message(result);
-        assert!(msg.contains(expected), "`{msg}` does not contain `{expected}`");
+        assert!(
+            msg.contains(expected),
+            "`{msg}` does not contain `{expected}`"
+        );
     }
 }
 
@@ -107,9 +153,15 @@ fn model_errors_name_the_place() {
 fn discretisation_errors() {
     assert!(matches!(
         HarmonicBasis::new(1.0, 8).unwrap().with_samples(16),
-        Err(Error::TooFewSamples { harmonics: 8, samples: 16 })
+        Err(Error::TooFewSamples {
+            harmonics: 8,
+            samples: 16
+        })
     ));
-    assert!(HarmonicBasis::new(-1.0, 8).unwrap_err().to_string().contains("omega"));
+    assert!(HarmonicBasis::new(-1.0, 8)
+        .unwrap_err()
+        .to_string()
+        .contains("omega"));
     assert!(HarmonicBasis::new(f64::NAN, 8).is_err());
     let model = Model::builder(&["a"])
         .mass_diagonal(&[1.0])
@@ -118,16 +170,30 @@ fn discretisation_errors() {
         .build()
         .unwrap();
     let err = HarmonicBalance::new(&model, HarmonicBasis::new(1.0, 3).unwrap()).unwrap_err();
-    assert!(err.to_string().contains("order 5 but only 3 harmonics"), "{err}");
+    assert!(
+        err.to_string().contains("order 5 but only 3 harmonics"),
+        "{err}"
+    );
     // A free rigid-body mode under a static load: singular at harmonic 0.
-    let free = Model::builder(&["a"]).mass_diagonal(&[1.0]).load("a", 0, 1.0, 0.0).build().unwrap();
+    let free = Model::builder(&["a"])
+        .mass_diagonal(&[1.0])
+        .load("a", 0, 1.0, 0.0)
+        .build()
+        .unwrap();
     let err = HarmonicBalance::new(&free, HarmonicBasis::new(1.0, 3).unwrap()).unwrap_err();
-    assert!(err.to_string().contains("harmonic 0") && err.to_string().contains("rigid-body"), "{err}");
+    assert!(
+        err.to_string().contains("harmonic 0") && err.to_string().contains("rigid-body"),
+        "{err}"
+    );
 }
 
 #[test]
 fn solver_option_errors() {
-    assert!(FixedPoint::new().with_gamma(1.0).unwrap_err().to_string().contains("gamma"));
+    assert!(FixedPoint::new()
+        .with_gamma(1.0)
+        .unwrap_err()
+        .to_string()
+        .contains("gamma"));
     assert!(FixedPoint::new().with_gamma(-0.1).is_err());
     assert!(FixedPoint::new().with_tolerance(f64::NAN).is_err());
     // Options set directly are validated at solve time.
@@ -137,10 +203,17 @@ fn solver_option_errors() {
         .build()
         .unwrap();
     let hb = HarmonicBalance::new(&model, HarmonicBasis::new(2.0, 3).unwrap()).unwrap();
-    let bad = FixedPoint { gamma: 2.0, ..FixedPoint::default() };
+    let bad = FixedPoint {
+        gamma: 2.0,
+        ..FixedPoint::default()
+    };
     assert!(bad.solve(&hb, &mut hb.workspace()).is_err());
-    let wrong_len = FixedPoint::new().solve_from(&hb, &[Default::default(); 2], &mut hb.workspace());
-    assert!(wrong_len.unwrap_err().to_string().contains("initial harmonics"));
+    let wrong_len =
+        FixedPoint::new().solve_from(&hb, &[Default::default(); 2], &mut hb.workspace());
+    assert!(wrong_len
+        .unwrap_err()
+        .to_string()
+        .contains("initial harmonics"));
 }
 
 /// A user law that returns NaN: the solve stops with a NonFinite termination naming the
@@ -158,7 +231,10 @@ fn non_finite_force_is_a_termination_not_a_nan() {
             (1.0 + 0.5 / u.sqrt(), 0.0)
         }
         fn linear_part(&self) -> hbal::force::LinearPart {
-            hbal::force::LinearPart { stiffness: 1.0, damping: 0.0 }
+            hbal::force::LinearPart {
+                stiffness: 1.0,
+                damping: 0.0,
+            }
         }
     }
     let model = Model::builder(&["a"])
@@ -174,7 +250,10 @@ fn non_finite_force_is_a_termination_not_a_nan() {
         hbal::Termination::NonFinite { what } => assert!(what.contains("root"), "{what}"),
         t => panic!("expected NonFinite, got {t:?}"),
     }
-    assert!(sol.harmonics().iter().all(|q| q.re.is_finite() && q.im.is_finite()));
+    assert!(sol
+        .harmonics()
+        .iter()
+        .all(|q| q.re.is_finite() && q.im.is_finite()));
     assert!(sol.history.iter().all(|r| r.is_finite()));
 }
 
@@ -184,7 +263,8 @@ fn non_finite_force_is_a_termination_not_a_nan() {
 fn divergence_is_reported() {
     let case = hbal::catalog::TwoShaft::new(6000.0);
     let model = case.model().unwrap();
-    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(case.mesh_omega(), 32).unwrap()).unwrap();
+    let hb =
+        HarmonicBalance::new(&model, HarmonicBasis::new(case.mesh_omega(), 32).unwrap()).unwrap();
     let sol = FixedPoint::new().solve(&hb, &mut hb.workspace()).unwrap();
     assert_eq!(sol.termination, hbal::Termination::Diverged);
     assert!(sol.stats.iterations < 200);

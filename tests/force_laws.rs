@@ -97,7 +97,10 @@ fn rectangular_mesh_values_mean_and_jumps() {
     assert!((lin.damping - 0.75).abs() < 1e-12);
     // The default linear part (average of the linearisation) agrees for this profile.
     let sampled: f64 = (0..4096)
-        .map(|j| mesh.derivatives(std::f64::consts::TAU * (j as f64 + 0.5) / 4096.0, 0.0, 0.0).0)
+        .map(|j| {
+            mesh.derivatives(std::f64::consts::TAU * (j as f64 + 0.5) / 4096.0, 0.0, 0.0)
+                .0
+        })
         .sum::<f64>()
         / 4096.0;
     assert!((sampled - 3.75e5).abs() < 1e-6);

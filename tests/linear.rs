@@ -86,10 +86,16 @@ fn two_dof_with_weighted_element_matches_direct_solve() {
         let z = DMatrix::from_fn(2, 2, |i, j| {
             Complex64::new(kt[(i, j)] - om * om * m[(i, j)], om * dt[(i, j)])
         });
-        let x = z.lu().solve(&nalgebra::DVector::from_row_slice(&f)).unwrap();
+        let x = z
+            .lu()
+            .solve(&nalgebra::DVector::from_row_slice(&f))
+            .unwrap();
         for i in 0..2 {
             let got = sol.harmonic(i, order);
-            assert!((got - x[i]).norm() < 1e-12 * x.norm(), "order {order} dof {i}");
+            assert!(
+                (got - x[i]).norm() < 1e-12 * x.norm(),
+                "order {order} dof {i}"
+            );
         }
     }
 }
@@ -106,6 +112,12 @@ fn undamped_resonance_is_an_error() {
     // ω_n = 2: harmonic 2 of Ω = 1 is resonant.
     let err = HarmonicBalance::new(&model, HarmonicBasis::new(1.0, 3).unwrap()).unwrap_err();
     let msg = err.to_string();
-    assert!(matches!(err, hbal::Error::SingularDynamicStiffness { harmonic: 2, .. }), "{msg}");
+    assert!(
+        matches!(
+            err,
+            hbal::Error::SingularDynamicStiffness { harmonic: 2, .. }
+        ),
+        "{msg}"
+    );
     assert!(msg.contains("harmonic 2"), "{msg}");
 }

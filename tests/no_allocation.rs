@@ -31,7 +31,8 @@ static GLOBAL: Counting = Counting;
 fn fixed_point_iterations_do_not_allocate() {
     let case = TwoShaft::new(60000.0);
     let model = case.model().unwrap();
-    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(case.mesh_omega(), 32).unwrap()).unwrap();
+    let hb =
+        HarmonicBalance::new(&model, HarmonicBasis::new(case.mesh_omega(), 32).unwrap()).unwrap();
     let mut ws = hb.workspace();
     let count = |iterations: usize, ws: &mut hbal::Workspace| {
         let solver = FixedPoint::new()

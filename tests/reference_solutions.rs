@@ -25,7 +25,10 @@ fn two_shaft_hb_matches_reference() {
         .with_max_iterations(2000);
     let mut errors = Vec::new();
     for h in [32usize, 128, 512] {
-        let basis = HarmonicBasis::new(case.mesh_omega(), h).unwrap().with_samples(16 * h).unwrap();
+        let basis = HarmonicBasis::new(case.mesh_omega(), h)
+            .unwrap()
+            .with_samples(16 * h)
+            .unwrap();
         let hb = HarmonicBalance::new(&model, basis).unwrap();
         let sol = solver.solve(&hb, &mut hb.workspace()).unwrap();
         assert!(sol.is_converged(), "H {h}: {:?}", sol.termination);
@@ -33,8 +36,14 @@ fn two_shaft_hb_matches_reference() {
     }
     // Rectangular stiffness: the spectrum decays like k^-3 and the error falls by more than
     // 10x for every 4x in H (measured: 2.7e-4, 1.2e-5, 7.4e-7).
-    assert!(errors[0] < 3e-4 && errors[1] < 2e-5 && errors[2] < 1e-6, "{errors:?}");
-    assert!(errors[1] < errors[0] / 10.0 && errors[2] < errors[1] / 10.0, "{errors:?}");
+    assert!(
+        errors[0] < 3e-4 && errors[1] < 2e-5 && errors[2] < 1e-6,
+        "{errors:?}"
+    );
+    assert!(
+        errors[1] < errors[0] / 10.0 && errors[2] < errors[1] / 10.0,
+        "{errors:?}"
+    );
 }
 
 /// The time-domain reference reproduces the shared reference and converges as rtol tightens.

@@ -29,7 +29,7 @@ pub fn check_derivatives(law: &dyn ForceLaw, points: &[(f64, f64, f64)]) -> Deri
         let fd_d = (law.force(theta, u, du + hd) - law.force(theta, u, du - hd)) / (2.0 * hd);
         for (analytic, numeric) in [(dfdu, fd_u), (dfddu, fd_d)] {
             let err = (analytic - numeric).abs() / analytic.abs().max(1.0);
-            if !(err <= worst.max_relative_error) {
+            if err > worst.max_relative_error || err.is_nan() {
                 worst = DerivativeCheck {
                     max_relative_error: err,
                     worst_point: (theta, u, du),

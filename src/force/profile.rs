@@ -105,7 +105,9 @@ impl MeshProfile {
     /// Checks the parameters.
     pub fn validate(&self, context: &str) -> Result<()> {
         match self {
-            MeshProfile::Constant { stiffness } => check_non_negative(context, "stiffness", *stiffness),
+            MeshProfile::Constant { stiffness } => {
+                check_non_negative(context, "stiffness", *stiffness)
+            }
             MeshProfile::Rectangular {
                 one_tooth,
                 two_tooth,

@@ -20,7 +20,9 @@ pub struct AftPlan {
 
 impl std::fmt::Debug for AftPlan {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("AftPlan").field("basis", &self.basis).finish()
+        f.debug_struct("AftPlan")
+            .field("basis", &self.basis)
+            .finish()
     }
 }
 
@@ -75,8 +77,12 @@ impl AftPlan {
         debug_assert_eq!(harmonics.len(), h + 1);
         s.spectrum.fill(Complex64::default());
         s.spectrum[0] = Complex64::new((harmonics[0] * scale(0)).re, 0.0);
-        for k in 1..=h {
-            s.spectrum[k] = harmonics[k] * scale(k) * 0.5;
+        for (k, (bin, q)) in s.spectrum[1..=h]
+            .iter_mut()
+            .zip(&harmonics[1..])
+            .enumerate()
+        {
+            *bin = q * scale(k + 1) * 0.5;
         }
         // For even N the last bin is the Nyquist bin, which must be real; N >= 2H+1 keeps it
         // empty. For odd N it is an ordinary harmonic.
@@ -94,8 +100,8 @@ impl AftPlan {
             .forward
             .process_with_scratch(x, &mut s.spectrum, &mut s.scratch);
         out[0] = Complex64::new(s.spectrum[0].re * inv_n, 0.0);
-        for k in 1..=h {
-            out[k] = s.spectrum[k] * (2.0 * inv_n);
+        for (o, bin) in out[1..=h].iter_mut().zip(&s.spectrum[1..=h]) {
+            *o = bin * (2.0 * inv_n);
         }
     }
 }

@@ -36,9 +36,11 @@ impl DynamicStiffness {
             let scale = k0.amax().max(w * w * m.amax()).max(w * d0.amax());
             let lu = z.clone().lu();
             let u = lu.u();
-            let min_pivot = (0..n).map(|i| u[(i, i)].norm()).fold(f64::INFINITY, f64::min);
+            let min_pivot = (0..n)
+                .map(|i| u[(i, i)].norm())
+                .fold(f64::INFINITY, f64::min);
             let relative_pivot = if scale > 0.0 { min_pivot / scale } else { 0.0 };
-            if !(relative_pivot > SINGULAR_PIVOT) {
+            if relative_pivot.is_nan() || relative_pivot <= SINGULAR_PIVOT {
                 let hint = if k == 0 {
                     "K0 is singular: a free rigid-body mode; ground it with a stiffness or \
                      fix the DOF"

@@ -5,6 +5,9 @@ use crate::error::{Error, Result};
 use crate::force::ForceLaw;
 use nalgebra::DMatrix;
 
+/// An element as given: name, `(DOF name, weight)` pairs, law.
+type PendingElement = (String, Vec<(String, f64)>, Box<dyn ForceLaw>);
+
 /// Collects a model's parts; [`ModelBuilder::build`] validates them all.
 #[derive(Debug)]
 pub struct ModelBuilder {
@@ -13,7 +16,7 @@ pub struct ModelBuilder {
     damping: Option<DMatrix<f64>>,
     stiffness: Option<DMatrix<f64>>,
     loads: Vec<(String, usize, f64, f64)>,
-    elements: Vec<(String, Vec<(String, f64)>, Box<dyn ForceLaw>)>,
+    elements: Vec<PendingElement>,
 }
 
 impl ModelBuilder {
@@ -61,12 +64,22 @@ impl ModelBuilder {
     }
 
     /// Adds a force element `law` on `u = Σ w_i q_i` over the named DOFs.
-    pub fn element(self, name: &str, weights: &[(&str, f64)], law: impl ForceLaw + 'static) -> Self {
+    pub fn element(
+        self,
+        name: &str,
+        weights: &[(&str, f64)],
+        law: impl ForceLaw + 'static,
+    ) -> Self {
         self.element_boxed(name, weights, Box::new(law))
     }
 
     /// Adds a boxed force element (e.g. deserialised from a scene file).
-    pub fn element_boxed(mut self, name: &str, weights: &[(&str, f64)], law: Box<dyn ForceLaw>) -> Self {
+    pub fn element_boxed(
+        mut self,
+        name: &str,
+        weights: &[(&str, f64)],
+        law: Box<dyn ForceLaw>,
+    ) -> Self {
         let w = weights.iter().map(|(d, w)| (d.to_string(), *w)).collect();
         self.elements.push((name.to_string(), w, law));
         self
@@ -104,14 +117,20 @@ impl ModelBuilder {
                 })
         };
 
-        let mass = self.mass.clone().ok_or_else(|| Error::MassNotPositiveDefinite {
-            reason: "no mass matrix given".into(),
-        })?;
+        let mass = self
+            .mass
+            .clone()
+            .ok_or_else(|| Error::MassNotPositiveDefinite {
+                reason: "no mass matrix given".into(),
+            })?;
         check_matrix("mass matrix", &mass, n)?;
         check_spd(&mass)?;
         let damping = self.damping.clone().unwrap_or_else(|| DMatrix::zeros(n, n));
         check_matrix("damping matrix", &damping, n)?;
-        let stiffness = self.stiffness.clone().unwrap_or_else(|| DMatrix::zeros(n, n));
+        let stiffness = self
+            .stiffness
+            .clone()
+            .unwrap_or_else(|| DMatrix::zeros(n, n));
         check_matrix("stiffness matrix", &stiffness, n)?;
 
         let mut loads = Vec::with_capacity(self.loads.len());
@@ -186,12 +205,7 @@ fn check_matrix(context: &str, m: &DMatrix<f64>, n: usize) -> Result<()> {
         .map(|(idx, v)| ((idx % n, idx / n), v))
         .find(|(_, v)| !v.is_finite())
     {
-        return Err(Error::invalid(
-            context,
-            format!("[{i}][{j}]"),
-            *v,
-            "finite",
-        ));
+        return Err(Error::invalid(context, format!("[{i}][{j}]"), *v, "finite"));
     }
     Ok(())
 }

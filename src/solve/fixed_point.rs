@@ -14,7 +14,7 @@
 
 use crate::error::{Error, Result};
 use crate::residual::{HarmonicBalance, Workspace};
-use crate::solution::{SolveStats, Solution, Termination};
+use crate::solution::{Solution, SolveStats, Termination};
 use num_complex::Complex64;
 use std::time::Instant;
 
@@ -119,7 +119,8 @@ impl FixedPoint {
     }
 
     fn iterate(&self, hb: &HarmonicBalance, ws: &mut Workspace) -> Result<Solution> {
-        self.with_gamma(self.gamma)?.with_tolerance(self.tolerance)?;
+        self.with_gamma(self.gamma)?
+            .with_tolerance(self.tolerance)?;
         let start = Instant::now();
         let n = hb.model().n_dofs();
         let h = hb.basis().harmonics();
@@ -160,7 +161,11 @@ impl FixedPoint {
                 let w = if idx < n { 1.0 } else { 0.5 };
                 r2 += w * (zq - rhs).norm_sqr();
             }
-            let rel = if scale > 0.0 { r2.sqrt() / scale } else { r2.sqrt() };
+            let rel = if scale > 0.0 {
+                r2.sqrt() / scale
+            } else {
+                r2.sqrt()
+            };
             if !rel.is_finite() {
                 break Termination::NonFinite {
                     what: "residual".into(),

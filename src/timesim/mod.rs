@@ -135,7 +135,9 @@ impl TimeSimulation {
         let mut diff = f64::INFINITY;
         while periods < self.max_periods {
             let prev = y.clone();
-            self.integrate_period(&rhs, &bounds, periods, period, &atol, &mut y, None, &mut steps, &mut evals)?;
+            self.integrate_period(
+                &rhs, &bounds, periods, period, &atol, &mut y, None, &mut steps, &mut evals,
+            )?;
             periods += 1;
             diff = prev
                 .iter()
@@ -326,8 +328,7 @@ fn state_scale(model: &Model, omega: f64) -> Vec<f64> {
     let (m, d0, k0) = (model.mass(), model.d0(), model.k0());
     let mut q = vec![0.0; n];
     let mut w_max: f64 = 0.0;
-    let orders: std::collections::BTreeSet<usize> =
-        model.loads().iter().map(|l| l.order).collect();
+    let orders: std::collections::BTreeSet<usize> = model.loads().iter().map(|l| l.order).collect();
     for k in orders {
         let w = k as f64 * omega;
         w_max = w_max.max(w);
@@ -348,7 +349,10 @@ fn state_scale(model: &Model, omega: f64) -> Vec<f64> {
     }
     if let Some(chol) = m.clone().cholesky() {
         // ω² are the eigenvalues of L⁻¹ K0 L⁻ᵀ (symmetric part), M = L Lᵀ.
-        let l_inv = chol.l().try_inverse().unwrap_or_else(|| DMatrix::identity(n, n));
+        let l_inv = chol
+            .l()
+            .try_inverse()
+            .unwrap_or_else(|| DMatrix::identity(n, n));
         let a = &l_inv * k0 * l_inv.transpose();
         let a = (&a + a.transpose()) * 0.5;
         let lambda = a.symmetric_eigenvalues().max();
@@ -357,7 +361,11 @@ fn state_scale(model: &Model, omega: f64) -> Vec<f64> {
         }
     }
     let qmax = q.iter().cloned().fold(0.0, f64::max);
-    let qs = if qmax > 0.0 && qmax.is_finite() { qmax } else { 1.0 };
+    let qs = if qmax > 0.0 && qmax.is_finite() {
+        qmax
+    } else {
+        1.0
+    };
     let vs = qs * if w_max > 0.0 { w_max } else { omega };
     let mut s = vec![qs; n];
     s.extend(std::iter::repeat_n(vs, n));

@@ -17,13 +17,14 @@ pub(super) struct Rhs<'m> {
 
 impl<'m> Rhs<'m> {
     pub(super) fn new(model: &'m Model, omega: f64) -> Result<Self> {
-        let chol = model
-            .mass()
-            .clone()
-            .cholesky()
-            .ok_or_else(|| Error::MassNotPositiveDefinite {
-                reason: "Cholesky factorisation failed".into(),
-            })?;
+        let chol =
+            model
+                .mass()
+                .clone()
+                .cholesky()
+                .ok_or_else(|| Error::MassNotPositiveDefinite {
+                    reason: "Cholesky factorisation failed".into(),
+                })?;
         Ok(Self {
             model,
             chol,
