@@ -108,3 +108,48 @@ fn gear_backlash_time_domain_matches_reference() {
     let err = relative_error(&td.harmonics, &r.harmonics, 1, 32);
     assert!(err < 1e-8, "TD error {err}");
 }
+
+/// Contact loss (W = 1: the gear pair opens its backlash, min x < b): the time-domain reference
+/// converges as rtol tightens, although the contact kink is left to the error control.
+#[test]
+fn gear_backlash_time_domain_converges_with_contact_loss() {
+    let model = GearBacklash::default().model().unwrap();
+    let mut runs = Vec::new();
+    for rtol in [1e-10, 1e-11, 1e-12] {
+        let td = TimeSimulation {
+            rtol,
+            steady_tolerance: 1e-10,
+            samples: 512,
+            initial: Some((vec![1.1], vec![0.0])),
+            ..TimeSimulation::default()
+        }
+        .run(&model, 1.0)
+        .unwrap();
+        assert!(td.converged, "rtol {rtol}: {:?}", td.stop);
+        let min = td.samples[0].iter().cloned().fold(f64::MAX, f64::min);
+        assert!(min < 0.95, "no contact loss: min x = {min}");
+        runs.push(td.harmonics);
+    }
+    let d1 = relative_error(&runs[0], &runs[2], 1, 32);
+    let d2 = relative_error(&runs[1], &runs[2], 1, 32);
+    assert!(d1 < 1e-6 && d2 < d1 / 2.0, "{d1:e} {d2:e}");
+}
+
+/// Integration noise above the steady tolerance stops the run as stalled instead of running
+/// for 100 000 periods.
+#[test]
+fn time_domain_reports_a_stall() {
+    let model = GearBacklash::default().model().unwrap();
+    let td = TimeSimulation {
+        rtol: 1e-6,
+        steady_tolerance: 1e-12,
+        stall_periods: 50,
+        samples: 64,
+        initial: Some((vec![1.1], vec![0.0])),
+        ..TimeSimulation::default()
+    }
+    .run(&model, 1.0)
+    .unwrap();
+    assert_eq!(td.stop, hbal::timesim::TimeStop::Stalled);
+    assert!(td.periods < 2000, "{}", td.periods);
+}

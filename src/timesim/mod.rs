@@ -35,6 +35,10 @@ pub struct TimeSimulation {
     pub steady_tolerance: f64,
     /// Give up after this many periods. Default 100 000.
     pub max_periods: usize,
+    /// Give up once the period-to-period difference has not improved on its best value for
+    /// this many periods: the integration noise (set by `rtol`, worst at contact kinks) is above
+    /// `steady_tolerance`. Default 200.
+    pub stall_periods: usize,
     /// Samples of the final period (harmonics up to N/2 - 1 are returned). Default 1024.
     pub samples: usize,
     /// Largest step as a fraction of the period, if any. Default none.
@@ -49,11 +53,25 @@ impl Default for TimeSimulation {
             rtol: 1e-10,
             steady_tolerance: 1e-8,
             max_periods: 100_000,
+            stall_periods: 200,
             samples: 1024,
             max_step: None,
             initial: None,
         }
     }
+}
+
+/// Why the time integration stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeStop {
+    /// Successive periods agree to the steady tolerance.
+    Steady,
+    /// `max_periods` reached while the difference was still falling.
+    MaxPeriods,
+    /// The difference stopped falling above the steady tolerance (`stall_periods` without a new
+    /// best): tighten `rtol` or loosen `steady_tolerance`.
+    Stalled,
 }
 
 /// The periodic response found by time integration.
@@ -63,8 +81,10 @@ pub struct TimeResponse {
     pub omega: f64,
     /// DOF names.
     pub dofs: Vec<String>,
-    /// `true` if the steady-state criterion was met within `max_periods`.
+    /// `true` if the steady-state criterion was met.
     pub converged: bool,
+    /// Why the integration stopped.
+    pub stop: TimeStop,
     /// Periods integrated until steady state.
     pub periods: usize,
     /// Accepted plus rejected steps until steady state.
@@ -133,6 +153,8 @@ impl TimeSimulation {
         let (mut steps, mut evals) = (0usize, 0usize);
         let mut periods = 0;
         let mut diff = f64::INFINITY;
+        let (mut best, mut best_period) = (f64::INFINITY, 0);
+        let mut stop = TimeStop::MaxPeriods;
         while periods < self.max_periods {
             let prev = y.clone();
             self.integrate_period(
@@ -151,11 +173,18 @@ impl TimeSimulation {
                 });
             }
             if diff < self.steady_tolerance {
+                stop = TimeStop::Steady;
+                break;
+            }
+            if diff < best {
+                (best, best_period) = (diff, periods);
+            } else if periods - best_period >= self.stall_periods {
+                stop = TimeStop::Stalled;
                 break;
             }
         }
         let wall_time = start.elapsed();
-        let converged = diff < self.steady_tolerance;
+        let converged = stop == TimeStop::Steady;
 
         // Sample one more period.
         let ns = self.samples;
@@ -190,6 +219,7 @@ impl TimeSimulation {
             omega,
             dofs: model.dof_names().to_vec(),
             converged,
+            stop,
             periods,
             steps,
             rhs_evaluations: evals,
@@ -208,6 +238,9 @@ impl TimeSimulation {
             return Err(Error::invalid(ctx, "rtol", self.rtol, "in (0, 1)"));
         }
         crate::error::check_positive(ctx, "steady_tolerance", self.steady_tolerance)?;
+        if self.stall_periods == 0 {
+            return Err(Error::invalid(ctx, "stall_periods", 0.0, ">= 1"));
+        }
         if self.samples < 8 {
             return Err(Error::invalid(ctx, "samples", self.samples as f64, ">= 8"));
         }
