@@ -57,6 +57,7 @@ pub mod compare;
 pub mod error;
 pub mod force;
 pub mod harmonic;
+pub mod jacobian;
 pub mod model;
 pub mod report;
 pub mod residual;

@@ -9,9 +9,10 @@
 //! whatever the number of DOFs). Elements that are linear and time-invariant cost nothing.
 
 use crate::error::{Error, Result};
-use crate::harmonic::{AftPlan, AftScratch, DynamicStiffness, HarmonicBasis};
+use crate::harmonic::{AftPlan, AftScratch, DynamicStiffness, HarmonicBasis, Part, RealLayout};
 use crate::model::Model;
 use crate::solution::SolveStats;
+use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 
@@ -45,6 +46,10 @@ pub struct AftBuffers {
     u: Vec<f64>,
     du: Vec<f64>,
     f: Vec<f64>,
+    gu: Vec<f64>,
+    gdu: Vec<f64>,
+    spec_u: Vec<Complex64>,
+    spec_du: Vec<Complex64>,
     /// Real FFTs done so far.
     pub ffts: usize,
     /// Force-law calls so far.
@@ -181,6 +186,10 @@ impl<'m> HarmonicBalance<'m> {
                 u: vec![0.0; s],
                 du: vec![0.0; s],
                 f: vec![0.0; s],
+                gu: vec![0.0; s],
+                gdu: vec![0.0; s],
+                spec_u: vec![Complex64::default(); s / 2 + 1],
+                spec_du: vec![Complex64::default(); s / 2 + 1],
                 ffts: 0,
                 force_evaluations: 0,
             },
@@ -197,6 +206,19 @@ impl<'m> HarmonicBalance<'m> {
         &self,
         q: &[Complex64],
         out: &mut [Complex64],
+        ws: &mut AftBuffers,
+    ) -> Result<()> {
+        self.aft_into(q, out, None, ws)
+    }
+
+    /// `out ← F_rest(Q)`, and, if `jac` is given, `jac += ∂F_rest/∂x` in the real layout
+    /// ([`RealLayout`]): per element `(w wᵀ) ⊗ L_e`, with `L_e` the exact derivative of the AFT
+    /// (see [`crate::jacobian`]), from the same samples.
+    pub fn aft_into(
+        &self,
+        q: &[Complex64],
+        out: &mut [Complex64],
+        mut jac: Option<&mut DMatrix<f64>>,
         ws: &mut AftBuffers,
     ) -> Result<()> {
         let (n, h) = (self.model.n_dofs(), self.basis.harmonics());
@@ -238,6 +260,91 @@ impl<'m> HarmonicBalance<'m> {
             ws.ffts += 3;
             for k in 0..=h {
                 e.scatter_add(ws.uk[k], &mut out[k * n..(k + 1) * n]);
+            }
+            if let Some(jac) = jac.as_deref_mut() {
+                law.derivatives_batch(&self.thetas, &ws.u, &ws.du, &mut ws.gu, &mut ws.gdu);
+                for &j in &act.jump_samples {
+                    let (t, u, du) = (self.thetas[j], ws.u[j], ws.du[j]);
+                    let (a0, b0) = law.derivatives(t - delta, u, du);
+                    let (a1, b1) = law.derivatives(t + delta, u, du);
+                    (ws.gu[j], ws.gdu[j]) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
+                }
+                for (g, d) in ws.gu.iter_mut().zip(ws.gdu.iter_mut()) {
+                    *g -= lin.stiffness;
+                    *d -= lin.damping;
+                }
+                if !ws.gu.iter().chain(&ws.gdu).all(|v| v.is_finite()) {
+                    return Err(Error::NonFinite {
+                        what: format!("force derivatives of element `{}`", e.name()),
+                    });
+                }
+                self.aft
+                    .spectrum_into(&mut ws.gu, &mut ws.spec_u, &mut ws.aft);
+                self.aft
+                    .spectrum_into(&mut ws.gdu, &mut ws.spec_du, &mut ws.aft);
+                ws.ffts += 2;
+                crate::jacobian::add_element_jacobian(
+                    &ws.spec_u,
+                    &ws.spec_du,
+                    self.basis.samples(),
+                    h,
+                    omega,
+                    e.weights(),
+                    n,
+                    jac,
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The real layout of the unknowns.
+    pub fn layout(&self) -> RealLayout {
+        RealLayout {
+            n: self.model.n_dofs(),
+            h: self.basis.harmonics(),
+        }
+    }
+
+    /// Fused residual and Jacobian in the real layout: `r ← R(x)`, and if `jac` is given,
+    /// `jac ← ∂R/∂x = Z ⊕ ∂F_rest/∂x` (the block `[[A, B], [-B, A]]` of
+    /// `Z_k = A + iB` for every harmonic, plus the AFT part). Both come from one AFT pass.
+    pub fn residual_real_into(
+        &self,
+        x: &[f64],
+        r: &mut [f64],
+        mut jac: Option<&mut DMatrix<f64>>,
+        ws: &mut Workspace,
+    ) -> Result<()> {
+        let layout = self.layout();
+        layout.unpack(x, &mut ws.q);
+        if let Some(j) = jac.as_deref_mut() {
+            j.fill(0.0);
+        }
+        self.aft_into(&ws.q, &mut ws.rest, jac.as_deref_mut(), &mut ws.eval)?;
+        let n = layout.n;
+        for k in 0..=layout.h {
+            let s = k * n..(k + 1) * n;
+            self.z.apply(k, &ws.q[s.clone()], &mut ws.zq[s.clone()]);
+            for i in s {
+                ws.rhs[i] = ws.zq[i] + ws.rest[i] - self.f_ext[i];
+            }
+        }
+        layout.pack(&ws.rhs, r);
+        if let Some(j) = jac {
+            for k in 0..=layout.h {
+                let z = self.z.matrix(k);
+                let ca = RealLayout::block(k, Part::Cos) * n;
+                let cb = RealLayout::block(k, Part::Sin) * n;
+                for (i, jj) in (0..n).flat_map(|i| (0..n).map(move |jj| (i, jj))) {
+                    let (a, b) = (z[(i, jj)].re, z[(i, jj)].im);
+                    j[(ca + i, ca + jj)] += a;
+                    if k > 0 {
+                        j[(ca + i, cb + jj)] += b;
+                        j[(cb + i, ca + jj)] -= b;
+                        j[(cb + i, cb + jj)] += a;
+                    }
+                }
             }
         }
         Ok(())

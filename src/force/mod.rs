@@ -81,6 +81,21 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
         }
     }
 
+    /// The derivatives at many samples: `(dfdu[j], dfddu[j]) = derivatives(θ[j], u[j], u̇[j])`.
+    /// The default loops over [`ForceLaw::derivatives`].
+    fn derivatives_batch(
+        &self,
+        theta: &[f64],
+        u: &[f64],
+        du: &[f64],
+        dfdu: &mut [f64],
+        dfddu: &mut [f64],
+    ) {
+        for j in 0..theta.len() {
+            (dfdu[j], dfddu[j]) = self.derivatives(theta[j], u[j], du[j]);
+        }
+    }
+
     /// The partial derivatives `(∂f/∂u, ∂f/∂u̇)` at `(θ, u, u̇)`, for Newton-type solvers.
     ///
     /// Where the law has a kink (contact), return either one-sided value.

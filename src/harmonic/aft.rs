@@ -104,4 +104,15 @@ impl AftPlan {
             *o = bin * (2.0 * inv_n);
         }
     }
+
+    /// Writes the normalised DFT bins `x̂_m = (1/N) Σ_j x_j e^{-imθ_j}`, `m = 0..=N/2`, of the
+    /// samples `x` (length N, overwritten) into `out` (length N/2 + 1). Bins of other `m` follow
+    /// from `x̂_{-m} = conj(x̂_m)` and periodicity in N.
+    pub fn spectrum_into(&self, x: &mut [f64], out: &mut [Complex64], s: &mut AftScratch) {
+        let inv_n = 1.0 / self.basis.samples() as f64;
+        let _ = self.forward.process_with_scratch(x, out, &mut s.scratch);
+        for v in out.iter_mut() {
+            *v *= inv_n;
+        }
+    }
 }

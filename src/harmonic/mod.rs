@@ -11,10 +11,12 @@
 mod aft;
 mod basis;
 mod dynamic_stiffness;
+mod packing;
 
 pub use aft::{AftPlan, AftScratch};
 pub use basis::HarmonicBasis;
 pub use dynamic_stiffness::DynamicStiffness;
+pub use packing::{Part, RealLayout};
 
 use num_complex::Complex64;
 
