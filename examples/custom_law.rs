@@ -36,6 +36,8 @@ impl ForceLaw for HertzContact {
     fn linear_part(&self) -> LinearPart {
         LinearPart {
             stiffness: self.derivatives(0.0, self.u_op, 0.0).0,
+            offset: self.force(0.0, self.u_op, 0.0)
+                - self.derivatives(0.0, self.u_op, 0.0).0 * self.u_op,
             damping: 0.0,
         }
     }

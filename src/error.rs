@@ -92,6 +92,12 @@ pub enum Error {
         /// Which quantity.
         what: String,
     },
+    /// The solver framework (argmin) reported an error.
+    #[error("solver failed: {reason}")]
+    Solver {
+        /// argmin's message.
+        reason: String,
+    },
     /// The time-domain reference integration failed.
     #[error("time integration failed: {reason}")]
     TimeIntegration {

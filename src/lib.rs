@@ -70,7 +70,7 @@ pub use harmonic::HarmonicBasis;
 pub use model::{Element, Model};
 pub use residual::{AftBuffers, HarmonicBalance, Workspace};
 pub use solution::{Solution, SolveStats, Termination};
-pub use solve::FixedPoint;
+pub use solve::{Anderson, Broyden, FixedPoint, Method, Newton};
 
 /// The README's code blocks run as doctests, so the README stays true.
 #[doc = include_str!("../README.md")]

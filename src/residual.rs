@@ -1,8 +1,10 @@
-//! The harmonic-balance problem: `R(Q) = Z(Ω) Q + F_rest(Q) - F_ext = 0`.
+//! The harmonic-balance problem: `R(Q) = Z(Ω) Q + F_rest(Q) - F_split = 0`.
 //!
 //! For every harmonic `k`, `Z_k = -(kΩ)² M + i kΩ D0 + K0` is the paper's dynamic stiffness
 //! (eq. 2) with the constant split `K0`, `D0` ([`Model::k0`], [`Model::d0`]). The rest
-//! `F_rest(Q)` collects, per element, `w (f(θ, u, u̇) - k0 u - d0 u̇)` with `u = w·q`: the paper's
+//! `F_rest(Q)` collects, per element, `w (f(θ, u, u̇) - f0 - k0 u - d0 u̇)` with `u = w·q`, and
+//! `F_split = F_ext - Σ w f0` (the static offsets `f0` of the linear parts moved to the load side,
+//! so the first, linear iterate already sits on an engaged contact): the paper's
 //! `D1(t) q̇ + K1(t) q` and any nonlinearity. It is evaluated by AFT: the element's local
 //! harmonics `U_k = w·Q_k` are synthesised to `u(θ_j)`, `u̇(θ_j)` at the N samples, the force is
 //! evaluated there, and an FFT brings it back (three real FFTs per time-varying element,
@@ -27,6 +29,8 @@ pub struct HarmonicBalance<'m> {
     aft: AftPlan,
     z: DynamicStiffness,
     f_ext: Vec<Complex64>,
+    /// `F_ext - Σ w f0`: the load seen by the split (offsets of the linear parts moved over).
+    f_split: Vec<Complex64>,
     active: Vec<ActiveElement>,
     thetas: Vec<f64>,
 }
@@ -98,6 +102,13 @@ impl<'m> HarmonicBalance<'m> {
             }
             f_ext[l.order * n + l.dof] += crate::harmonic::from_cos_sin(l.cos, l.sin);
         }
+        let mut f_split = f_ext.clone();
+        for e in model.elements() {
+            e.scatter_add(
+                Complex64::new(-e.linear_part().offset, 0.0),
+                &mut f_split[..n],
+            );
+        }
         let z = DynamicStiffness::new(&basis, model.mass(), &model.d0(), &model.k0())?;
         let samples = basis.samples();
         let thetas: Vec<f64> = (0..samples).map(|j| basis.theta(j)).collect();
@@ -131,6 +142,7 @@ impl<'m> HarmonicBalance<'m> {
             aft: AftPlan::new(basis),
             z,
             f_ext,
+            f_split,
             active,
             thetas,
         })
@@ -159,6 +171,12 @@ impl<'m> HarmonicBalance<'m> {
     /// Load harmonics `F_ext` ((H+1)·n, harmonic-major).
     pub fn external_load(&self) -> &[Complex64] {
         &self.f_ext
+    }
+
+    /// The load of the split, `F_ext - Σ_e w_e f0_e`: with it, `R = Z Q + F_rest(Q) - F_split`
+    /// where `F_rest` is evaluated without the offsets `f0` of the linear parts.
+    pub fn split_load(&self) -> &[Complex64] {
+        &self.f_split
     }
 
     /// Length of a harmonic vector, (H+1)·n.
@@ -241,14 +259,14 @@ impl<'m> HarmonicBalance<'m> {
             let lin = e.linear_part();
             law.force_batch(&self.thetas, &ws.u, &ws.du, &mut ws.f);
             for ((f, &u), &du) in ws.f.iter_mut().zip(&ws.u).zip(&ws.du) {
-                *f -= lin.stiffness * u + lin.damping * du;
+                *f -= lin.offset + lin.stiffness * u + lin.damping * du;
             }
             // A sample on a time jump takes the mean of both one-sided limits.
             let delta = 1e-7 * TAU / self.basis.samples() as f64;
             for &j in &act.jump_samples {
                 let (t, u, du) = (self.thetas[j], ws.u[j], ws.du[j]);
                 let mean = 0.5 * (law.force(t - delta, u, du) + law.force(t + delta, u, du));
-                ws.f[j] = mean - lin.stiffness * u - lin.damping * du;
+                ws.f[j] = mean - lin.offset - lin.stiffness * u - lin.damping * du;
             }
             ws.force_evaluations += self.basis.samples() + 2 * act.jump_samples.len();
             if !ws.f.iter().all(|v| v.is_finite()) {
@@ -327,46 +345,37 @@ impl<'m> HarmonicBalance<'m> {
             let s = k * n..(k + 1) * n;
             self.z.apply(k, &ws.q[s.clone()], &mut ws.zq[s.clone()]);
             for i in s {
-                ws.rhs[i] = ws.zq[i] + ws.rest[i] - self.f_ext[i];
+                ws.rhs[i] = ws.zq[i] + ws.rest[i] - self.f_split[i];
             }
         }
         layout.pack(&ws.rhs, r);
         if let Some(j) = jac {
-            for k in 0..=layout.h {
-                let z = self.z.matrix(k);
-                let ca = RealLayout::block(k, Part::Cos) * n;
-                let cb = RealLayout::block(k, Part::Sin) * n;
-                for (i, jj) in (0..n).flat_map(|i| (0..n).map(move |jj| (i, jj))) {
-                    let (a, b) = (z[(i, jj)].re, z[(i, jj)].im);
-                    j[(ca + i, ca + jj)] += a;
-                    if k > 0 {
-                        j[(ca + i, cb + jj)] += b;
-                        j[(cb + i, ca + jj)] -= b;
-                        j[(cb + i, cb + jj)] += a;
-                    }
-                }
-            }
+            self.add_dynamic_stiffness_real(j);
         }
         Ok(())
     }
 
-    /// `r ← R(Q) = Z Q + F_rest(Q) - F_ext`.
-    pub fn residual_into(
-        &self,
-        q: &[Complex64],
-        r: &mut [Complex64],
-        ws: &mut Workspace,
-    ) -> Result<()> {
-        self.rest_into(q, &mut ws.rest, &mut ws.eval)?;
-        let n = self.model.n_dofs();
-        for k in 0..=self.basis.harmonics() {
-            let s = k * n..(k + 1) * n;
-            self.z.apply(k, &q[s.clone()], &mut r[s.clone()]);
-            for i in s {
-                r[i] += ws.rest[i] - self.f_ext[i];
+    /// `jac += Z` in the real layout: the block `[[A, B], [-B, A]]` of `Z_k = A + iB` per
+    /// harmonic (`K0` alone at k = 0).
+    pub fn add_dynamic_stiffness_real(&self, jac: &mut DMatrix<f64>) {
+        let layout = self.layout();
+        let n = layout.n;
+        for k in 0..=layout.h {
+            let z = self.z.matrix(k);
+            let ca = RealLayout::block(k, Part::Cos) * n;
+            let cb = RealLayout::block(k, Part::Sin) * n;
+            for i in 0..n {
+                for jj in 0..n {
+                    let (a, b) = (z[(i, jj)].re, z[(i, jj)].im);
+                    jac[(ca + i, ca + jj)] += a;
+                    if k > 0 {
+                        jac[(ca + i, cb + jj)] += b;
+                        jac[(cb + i, ca + jj)] -= b;
+                        jac[(cb + i, cb + jj)] += a;
+                    }
+                }
             }
         }
-        Ok(())
     }
 
     /// Parseval norm `sqrt(Σ_i [|X_0i|² + ½ Σ_k |X_ki|²])`: the RMS over one period, summed

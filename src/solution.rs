@@ -21,6 +21,14 @@ pub enum Termination {
         /// What turned non-finite.
         what: String,
     },
+    /// The Newton or Broyden matrix is singular (a pivot below 1e-14 of its scale).
+    SingularJacobian,
+    /// The line search found no step that reduces the residual.
+    LineSearchFailed,
+    /// The wall-time limit was reached.
+    Timeout,
+    /// Interrupted from outside.
+    Interrupted,
 }
 
 impl std::fmt::Display for Termination {
@@ -30,6 +38,10 @@ impl std::fmt::Display for Termination {
             Termination::MaxIterations => write!(f, "maximum iterations reached"),
             Termination::Diverged => write!(f, "diverged"),
             Termination::NonFinite { what } => write!(f, "non-finite value in {what}"),
+            Termination::SingularJacobian => write!(f, "singular Jacobian"),
+            Termination::LineSearchFailed => write!(f, "line search failed to reduce the residual"),
+            Termination::Timeout => write!(f, "time limit reached"),
+            Termination::Interrupted => write!(f, "interrupted"),
         }
     }
 }
@@ -45,6 +57,10 @@ pub struct SolveStats {
     pub ffts: usize,
     /// Calls of [`ForceLaw::force`](crate::force::ForceLaw::force).
     pub force_evaluations: usize,
+    /// Jacobian evaluations (Newton, Broyden restarts).
+    pub jacobians: usize,
+    /// Dense LU factorisations of a Jacobian.
+    pub factorizations: usize,
 }
 
 /// A periodic solution `q(θ) = Re Σ_k Q_k e^{ikθ}`, `θ = Ω t`, with how it was obtained.

@@ -233,7 +233,7 @@ fn non_finite_force_is_a_termination_not_a_nan() {
         fn linear_part(&self) -> hbal::force::LinearPart {
             hbal::force::LinearPart {
                 stiffness: 1.0,
-                damping: 0.0,
+                ..Default::default()
             }
         }
     }

@@ -12,8 +12,9 @@ use crate::error::{check_finite, check_non_negative, Error, Result};
 /// `φ = z θ + φ0`), and contact damping `c` acting only in contact. The classic gear pair
 /// `x'' + 2ζ x' + k(t) g(x) = F(t)` is one such element on a unit mass.
 ///
-/// Its linear part is the mean contact stiffness and `c` (the engaged mesh): the iteration is
-/// centred on the closed contact, which is where a loaded gear pair runs.
+/// Its linear part is the engaged mesh on the chosen [`Flank`]: `f ≈ k̄ (u ∓ b) + c u̇` with
+/// the mean contact stiffness `k̄` (offset `∓k̄ b`): the iteration is centred on the closed
+/// contact, where a loaded gear pair runs.
 ///
 /// ```
 /// use hbal::force::{Backlash, ForceLaw, MeshProfile};
@@ -37,6 +38,21 @@ pub struct Backlash {
     /// Contact damping c (>= 0), acting only in contact; default 0.
     #[serde(default)]
     pub contact_damping: f64,
+    /// The flank the iteration linearises about: `drive` (`u > b`, default) or `coast`
+    /// (`u < -b`). Only the starting point and the paper's split depend on it.
+    #[serde(default)]
+    pub flank: Flank,
+}
+
+/// A gear flank of a backlash contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Flank {
+    /// Drive flank, `u > b`.
+    #[default]
+    Drive,
+    /// Coast flank, `u < -b`.
+    Coast,
 }
 
 fn one() -> u32 {
@@ -53,6 +69,7 @@ impl Backlash {
             teeth: 1,
             phase: 0.0,
             contact_damping: 0.0,
+            flank: Flank::Drive,
         }
     }
 
@@ -94,9 +111,15 @@ impl ForceLaw for Backlash {
         }
     }
     fn linear_part(&self) -> LinearPart {
+        let k = self.stiffness.mean();
+        let offset = match self.flank {
+            Flank::Drive => -k * self.half_backlash,
+            Flank::Coast => k * self.half_backlash,
+        };
         LinearPart {
-            stiffness: self.stiffness.mean(),
+            stiffness: k,
             damping: self.contact_damping,
+            offset,
         }
     }
     fn time_breakpoints(&self) -> Vec<f64> {

@@ -37,6 +37,7 @@ impl ForceLaw for CubicSpring {
         LinearPart {
             stiffness: self.k,
             damping: self.d,
+            offset: 0.0,
         }
     }
     fn validate(&self, context: &str) -> Result<()> {

@@ -33,6 +33,7 @@ impl ForceLaw for LinearSpring {
         LinearPart {
             stiffness: self.k,
             damping: self.d,
+            offset: 0.0,
         }
     }
     fn is_linear_time_invariant(&self) -> bool {

@@ -109,6 +109,7 @@ impl ForceLaw for MeshStiffness {
         LinearPart {
             stiffness: k,
             damping: self.damping.value(k),
+            offset: 0.0,
         }
     }
     fn time_breakpoints(&self) -> Vec<f64> {

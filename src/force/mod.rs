@@ -21,7 +21,7 @@ mod linear_spring;
 mod mesh_stiffness;
 mod profile;
 
-pub use backlash::Backlash;
+pub use backlash::{Backlash, Flank};
 pub use check::{check_derivatives, DerivativeCheck};
 pub use cubic_spring::CubicSpring;
 pub use linear_spring::LinearSpring;
@@ -31,13 +31,18 @@ pub use profile::{MeshDamping, MeshProfile};
 use crate::Result;
 use std::f64::consts::TAU;
 
-/// The constant linear part `(k0, d0)` of a force law, kept in `K0` and `D0`.
+/// The constant linear part `f ≈ f0 + k0 u + d0 u̇` of a force law: `k0`, `d0` go into `K0`,
+/// `D0`; the offset `f0` is a static force of the linearisation (a contact engaged at
+/// `u = b` has `f ≈ k (u - b)`, so `f0 = -k b`).
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct LinearPart {
     /// Stiffness `k0 = ∂f/∂u`, averaged.
     pub stiffness: f64,
     /// Damping `d0 = ∂f/∂u̇`, averaged.
     pub damping: f64,
+    /// Static offset `f0`; default 0.
+    #[serde(default)]
+    pub offset: f64,
 }
 
 /// A scalar force law `f(θ, u, u̇)` of one element.
@@ -118,7 +123,18 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
         LinearPart {
             stiffness: k / POINTS as f64,
             damping: d / POINTS as f64,
+            offset: self.force_mean_at_rest(),
         }
+    }
+
+    /// The time average of `f(θ, 0, 0)` (64-point rule): the default offset of
+    /// [`ForceLaw::linear_part`].
+    fn force_mean_at_rest(&self) -> f64 {
+        const POINTS: usize = 64;
+        (0..POINTS)
+            .map(|j| self.force(TAU * j as f64 / POINTS as f64, 0.0, 0.0))
+            .sum::<f64>()
+            / POINTS as f64
     }
 
     /// Angles `θ ∈ [0, 2π)` where the force jumps in time (a rectangular mesh stiffness).

@@ -172,6 +172,7 @@ impl ModelBuilder {
             let linear = law.linear_part();
             crate::error::check_finite(&ctx, "linear part k0", linear.stiffness)?;
             crate::error::check_finite(&ctx, "linear part d0", linear.damping)?;
+            crate::error::check_finite(&ctx, "linear part offset", linear.offset)?;
             elements.push(Element {
                 name,
                 weights: w,

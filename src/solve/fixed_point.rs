@@ -10,13 +10,16 @@
 //!
 //! The first solve from `Q = 0` is the classic linear frequency-domain solution. The residual
 //! `R(Q) = Z Q - F_rhs(Q)` of every iterate comes from the same AFT and is checked against the
-//! tolerance before the next solve.
+//! tolerance before the next solve. In the notation of the other solvers this is
+//! `x ← x - (1-γ) Z⁻¹ R(x)`: Newton's update with the dynamic stiffness for the Jacobian.
 
+use super::problem::HbProblem;
+use super::run::{check_tolerance, initial_x, run, HbSolver, HbState, Limits, Progress};
 use crate::error::{Error, Result};
 use crate::residual::{HarmonicBalance, Workspace};
-use crate::solution::{Solution, SolveStats, Termination};
+use crate::solution::{Solution, Termination};
+use argmin::core::{Problem, Solver, TerminationReason, TerminationStatus, KV};
 use num_complex::Complex64;
-use std::time::Instant;
 
 /// Options of the paper's fixed-point iteration.
 ///
@@ -76,14 +79,7 @@ impl FixedPoint {
 
     /// Sets the relative residual tolerance, in [0, 1) (0: run to the iteration limit).
     pub fn with_tolerance(mut self, tolerance: f64) -> Result<Self> {
-        if !(tolerance.is_finite() && (0.0..1.0).contains(&tolerance)) {
-            return Err(Error::invalid(
-                "fixed point",
-                "tolerance",
-                tolerance,
-                "in [0, 1)",
-            ));
-        }
+        check_tolerance("fixed point", tolerance)?;
         self.tolerance = tolerance;
         Ok(self)
     }
@@ -96,8 +92,7 @@ impl FixedPoint {
 
     /// Solves from `Q = 0`: the first iterate is the linear frequency-domain solution.
     pub fn solve(&self, hb: &HarmonicBalance, ws: &mut Workspace) -> Result<Solution> {
-        ws.q.fill(Complex64::default());
-        self.iterate(hb, ws)
+        self.solve_from_option(hb, None, ws)
     }
 
     /// Solves from the warm start `initial` (harmonic-major, `(H+1)·n`).
@@ -107,106 +102,122 @@ impl FixedPoint {
         initial: &[Complex64],
         ws: &mut Workspace,
     ) -> Result<Solution> {
-        if initial.len() != hb.len() {
-            return Err(Error::DimensionMismatch {
-                context: "initial harmonics".into(),
-                expected: format!("{} ((H+1) * n)", hb.len()),
-                got: initial.len().to_string(),
-            });
-        }
-        ws.q.copy_from_slice(initial);
-        self.iterate(hb, ws)
+        self.solve_from_option(hb, Some(initial), ws)
     }
 
-    fn iterate(&self, hb: &HarmonicBalance, ws: &mut Workspace) -> Result<Solution> {
+    pub(crate) fn solve_from_option(
+        &self,
+        hb: &HarmonicBalance,
+        initial: Option<&[Complex64]>,
+        ws: &mut Workspace,
+    ) -> Result<Solution> {
         self.with_gamma(self.gamma)?
             .with_tolerance(self.tolerance)?;
-        let start = Instant::now();
-        let n = hb.model().n_dofs();
-        let h = hb.basis().harmonics();
-        let z = hb.dynamic_stiffness();
-        let f_ext = hb.external_load();
-        let ext_norm = hb.norm(f_ext);
-        ws.stats = SolveStats::default();
-        ws.eval.ffts = 0;
-        ws.eval.force_evaluations = 0;
-        let mut history = Vec::with_capacity(self.max_iterations + 1);
-        let mut best = f64::INFINITY;
-        let termination = loop {
-            // Steps 2a-2b: time-domain rest and its harmonics.
-            let evaluated = hb.rest_into(&ws.q, &mut ws.rest, &mut ws.eval);
-            ws.stats.residual_evaluations += 1;
-            if let Err(e) = evaluated {
-                break Termination::NonFinite {
-                    what: e.to_string(),
-                };
-            }
-            // Residual of the current iterate: R = Z Q - (F_ext - F_rest).
-            for k in 0..=h {
-                let s = k * n..(k + 1) * n;
-                z.apply(k, &ws.q[s.clone()], &mut ws.zq[s.clone()]);
-                for i in s {
-                    ws.rhs[i] = f_ext[i] - ws.rest[i];
-                }
-            }
-            // Relative to the load, so that divergence shows as growth; without a load, relative
-            // to the larger of the linear and the rest force.
-            let scale = if ext_norm > 0.0 {
-                ext_norm
-            } else {
-                hb.norm(&ws.zq).max(hb.norm(&ws.rest))
-            };
-            let mut r2 = 0.0;
-            for (idx, (zq, rhs)) in ws.zq.iter().zip(&ws.rhs).enumerate() {
-                let w = if idx < n { 1.0 } else { 0.5 };
-                r2 += w * (zq - rhs).norm_sqr();
-            }
-            let rel = if scale > 0.0 {
-                r2.sqrt() / scale
-            } else {
-                r2.sqrt()
-            };
-            if !rel.is_finite() {
-                break Termination::NonFinite {
-                    what: "residual".into(),
-                };
-            }
-            history.push(rel);
-            best = best.min(rel);
-            if rel <= self.tolerance {
-                break Termination::Converged;
-            }
-            if ws.stats.iterations >= self.max_iterations {
-                break Termination::MaxIterations;
-            }
-            if rel > self.divergence_factor * best {
-                break Termination::Diverged;
-            }
-            // Step 2c: Q' = Z⁻¹ F_rhs per harmonic; step 2d: relax.
-            for k in 0..=h {
-                z.solve_in_place(k, &mut ws.rhs[k * n..(k + 1) * n]);
-            }
-            if !ws.rhs.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
-                break Termination::NonFinite {
-                    what: "linear solve".into(),
-                };
-            }
-            let g = self.gamma;
-            for (q, qn) in ws.q.iter_mut().zip(&ws.rhs) {
-                *q = *q * g + qn * (1.0 - g);
-            }
-            ws.stats.iterations += 1;
+        if !(self.divergence_factor.is_finite() && self.divergence_factor > 1.0) {
+            return Err(Error::invalid(
+                "fixed point",
+                "divergence_factor",
+                self.divergence_factor,
+                "finite and > 1",
+            ));
+        }
+        let x0 = initial_x(hb, initial, false)?;
+        let solver = FixedPointSolver::new(*self, x0);
+        let limits = Limits {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations,
+            timeout: None,
         };
-        ws.stats.ffts = ws.eval.ffts;
-        ws.stats.force_evaluations = ws.eval.force_evaluations;
-        Ok(Solution {
-            basis: *hb.basis(),
-            dofs: hb.model().dof_names().to_vec(),
-            harmonics: ws.q.clone(),
-            termination,
-            history,
-            stats: ws.stats,
-            wall_time: start.elapsed(),
-        })
+        run(hb, ws, solver, limits)
+    }
+}
+
+/// The fixed point as an argmin [`Solver`].
+#[derive(Debug, Clone)]
+pub struct FixedPointSolver {
+    options: FixedPoint,
+    /// `G(x)` of the current iterate.
+    g: Vec<f64>,
+    /// The previous iterate, restored if the next evaluation fails.
+    x_prev: Vec<f64>,
+    best: f64,
+    progress: Progress,
+}
+
+impl FixedPointSolver {
+    /// A solver starting at `x0` (real layout).
+    pub fn new(options: FixedPoint, x0: Vec<f64>) -> Self {
+        let m = x0.len();
+        Self {
+            options,
+            g: vec![0.0; m],
+            x_prev: vec![0.0; m],
+            best: f64::INFINITY,
+            progress: Progress::new(x0, options.max_iterations),
+        }
+    }
+
+    fn evaluate(&mut self, problem: &HbProblem, state: HbState) -> HbState {
+        match problem.fixed_point_map(&self.progress.x, &mut self.g) {
+            Ok(rel) if rel.is_finite() && self.g.iter().all(|v| v.is_finite()) => {
+                self.progress.history.push(rel);
+                self.best = self.best.min(rel);
+                state.cost(rel)
+            }
+            Ok(_) => self.fail(state, "residual or linear solve".into()),
+            Err(e) => self.fail(state, e.to_string()),
+        }
+    }
+
+    fn fail(&mut self, state: HbState, what: String) -> HbState {
+        if !self.progress.history.is_empty() {
+            self.progress.x.copy_from_slice(&self.x_prev);
+        }
+        self.progress.stop(state, Termination::NonFinite { what })
+    }
+}
+
+impl HbSolver for FixedPointSolver {
+    fn progress(&self) -> &Progress {
+        &self.progress
+    }
+}
+
+impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for FixedPointSolver {
+    fn name(&self) -> &str {
+        "fixed point"
+    }
+
+    fn init(
+        &mut self,
+        problem: &mut Problem<HbProblem<'a, 'm>>,
+        state: HbState,
+    ) -> std::result::Result<(HbState, Option<KV>), argmin::core::Error> {
+        let p = problem.problem.as_ref().expect("problem present");
+        self.x_prev.copy_from_slice(&self.progress.x);
+        Ok((self.evaluate(p, state), None))
+    }
+
+    fn next_iter(
+        &mut self,
+        problem: &mut Problem<HbProblem<'a, 'm>>,
+        state: HbState,
+    ) -> std::result::Result<(HbState, Option<KV>), argmin::core::Error> {
+        let p = problem.problem.as_ref().expect("problem present");
+        let g = self.options.gamma;
+        self.x_prev.copy_from_slice(&self.progress.x);
+        for (x, gx) in self.progress.x.iter_mut().zip(&self.g) {
+            *x = g * *x + (1.0 - g) * gx;
+        }
+        p.count_iteration();
+        Ok((self.evaluate(p, state), None))
+    }
+
+    fn terminate(&mut self, state: &HbState) -> TerminationStatus {
+        if state.get_cost() > self.options.divergence_factor * self.best {
+            self.progress.termination = Some(Termination::Diverged);
+            return TerminationStatus::Terminated(TerminationReason::SolverExit(String::new()));
+        }
+        TerminationStatus::NotTerminated
     }
 }

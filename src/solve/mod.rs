@@ -1,7 +1,24 @@
-//! Solvers on the harmonic residual `R(Q) = Z Q + F_rest(Q) - F_ext`.
+//! Solvers on the harmonic residual `R(x) = Z x + F_rest(x) - F_ext`, as argmin solvers run
+//! by argmin's `Executor`.
 //!
-//! [`FixedPoint`] is the paper's iteration (section 3, steps 2a-2e).
+//! All are the update `x ← x - a J⁻¹ R(x)` with a different `J`: the dynamic stiffness `Z`
+//! ([`FixedPoint`], the paper's iteration, `a = 1 - γ`), the exact AFT Jacobian ([`Newton`]),
+//! rank-one updates ([`Broyden`]); [`Anderson`] accelerates the fixed-point map with the
+//! history of its last iterates. [`Method`] picks one at run time.
 
+mod anderson;
+mod broyden;
 mod fixed_point;
+pub mod lu;
+mod method;
+mod newton;
+mod problem;
+mod run;
 
-pub use fixed_point::FixedPoint;
+pub use anderson::{Anderson, AndersonSolver};
+pub use broyden::{Broyden, BroydenSolver, InitialJacobian};
+pub use fixed_point::{FixedPoint, FixedPointSolver};
+pub use method::Method;
+pub use newton::{Newton, NewtonSolver};
+pub use problem::HbProblem;
+pub use run::{HbSolver, HbState, Progress};

@@ -1,0 +1,131 @@
+//! The argmin problem adapter: the harmonic residual with its buffers behind a `RefCell`
+//! (argmin's problem traits take `&self`).
+
+use crate::error::Result;
+use crate::harmonic::RealLayout;
+use crate::residual::{HarmonicBalance, Workspace};
+use nalgebra::DMatrix;
+use std::cell::RefCell;
+
+/// `R(x)` on real unknowns, its Jacobian, and the paper's fixed-point map, for the solvers.
+pub struct HbProblem<'a, 'm> {
+    hb: &'a HarmonicBalance<'m>,
+    ws: RefCell<&'a mut Workspace>,
+    ext_norm: f64,
+}
+
+impl<'a, 'm> HbProblem<'a, 'm> {
+    /// Wraps `hb` and the workspace the solve may use.
+    pub fn new(hb: &'a HarmonicBalance<'m>, ws: &'a mut Workspace) -> Self {
+        let ext_norm = hb.norm(hb.external_load());
+        Self {
+            hb,
+            ws: RefCell::new(ws),
+            ext_norm,
+        }
+    }
+
+    /// The discretised model.
+    pub fn hb(&self) -> &'a HarmonicBalance<'m> {
+        self.hb
+    }
+
+    /// The real layout.
+    pub fn layout(&self) -> RealLayout {
+        self.hb.layout()
+    }
+
+    /// The relative residual `‖R‖ / ‖F_ext‖` (without a load, relative to
+    /// `max(‖Z Q‖, ‖F_rest‖)`), from the buffers of the last evaluation.
+    fn relative(&self, ws: &Workspace, r_norm: f64) -> f64 {
+        let scale = if self.ext_norm > 0.0 {
+            self.ext_norm
+        } else {
+            self.hb.norm(&ws.zq).max(self.hb.norm(&ws.rest))
+        };
+        if scale > 0.0 {
+            r_norm / scale
+        } else {
+            r_norm
+        }
+    }
+
+    /// `r ← R(x)` (and `jac ← ∂R/∂x`); returns the relative residual.
+    pub fn residual(
+        &self,
+        x: &[f64],
+        r: &mut [f64],
+        jac: Option<&mut DMatrix<f64>>,
+    ) -> Result<f64> {
+        let mut ws = self.ws.borrow_mut();
+        if jac.is_some() {
+            ws.stats.jacobians += 1;
+        }
+        ws.stats.residual_evaluations += 1;
+        self.hb.residual_real_into(x, r, jac, &mut ws)?;
+        let rel = self.relative(&ws, self.layout().norm(r));
+        Ok(rel)
+    }
+
+    /// The paper's map `g ← G(x) = Z⁻¹ (F_ext - F_rest(x))` (steps 2a-2c, one per-harmonic solve)
+    /// and the relative residual at `x` from the same evaluation (`R = Z x - Z G(x)`).
+    pub fn fixed_point_map(&self, x: &[f64], g: &mut [f64]) -> Result<f64> {
+        let mut ws = self.ws.borrow_mut();
+        let ws = &mut **ws;
+        let hb = self.hb;
+        let layout = hb.layout();
+        layout.unpack(x, &mut ws.q);
+        ws.stats.residual_evaluations += 1;
+        hb.rest_into(&ws.q, &mut ws.rest, &mut ws.eval)?;
+        let n = layout.n;
+        let z = hb.dynamic_stiffness();
+        let f_ext = hb.split_load();
+        let mut r2 = 0.0;
+        for k in 0..=layout.h {
+            let s = k * n..(k + 1) * n;
+            z.apply(k, &ws.q[s.clone()], &mut ws.zq[s.clone()]);
+            let w = if k == 0 { 1.0 } else { 0.5 };
+            for i in s.clone() {
+                ws.rhs[i] = f_ext[i] - ws.rest[i];
+                r2 += w * (ws.zq[i] - ws.rhs[i]).norm_sqr();
+            }
+            z.solve_in_place(k, &mut ws.rhs[s]);
+        }
+        layout.pack(&ws.rhs, g);
+        Ok(self.relative(ws, r2.sqrt()))
+    }
+
+    /// Counts one solver iteration.
+    pub(crate) fn count_iteration(&self) {
+        self.ws.borrow_mut().stats.iterations += 1;
+    }
+
+    /// Counts one LU factorisation.
+    pub(crate) fn count_factorization(&self) {
+        self.ws.borrow_mut().stats.factorizations += 1;
+    }
+
+    /// `jac ← Z` in the real layout (the block-diagonal dynamic stiffness, without the AFT
+    /// part): Broyden's cheap initial Jacobian.
+    pub fn dynamic_stiffness_into(&self, jac: &mut DMatrix<f64>) {
+        jac.fill(0.0);
+        self.hb.add_dynamic_stiffness_real(jac);
+    }
+
+    /// Moves the workspace's counters into a result and resets them.
+    pub(crate) fn take_stats(&self) -> crate::SolveStats {
+        let mut ws = self.ws.borrow_mut();
+        let mut stats = ws.stats;
+        stats.ffts = ws.eval.ffts;
+        stats.force_evaluations = ws.eval.force_evaluations;
+        ws.stats = Default::default();
+        ws.eval.ffts = 0;
+        ws.eval.force_evaluations = 0;
+        stats
+    }
+
+    /// Resets the counters before a solve.
+    pub(crate) fn reset_stats(&self) {
+        let _ = self.take_stats();
+    }
+}

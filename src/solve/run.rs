@@ -1,0 +1,160 @@
+//! Running a solver with argmin's `Executor` and turning its state into a [`Solution`].
+
+use super::problem::HbProblem;
+use crate::error::{Error, Result};
+use crate::residual::{HarmonicBalance, Workspace};
+use crate::solution::{Solution, Termination};
+use argmin::core::{Executor, IterState, Solver, State, TerminationReason};
+use num_complex::Complex64;
+use std::time::{Duration, Instant};
+
+/// argmin's iteration state for hbal: the cost is the relative residual. The iterate itself
+/// stays in the solver's buffers (argmin would clone a parameter vector on every improvement).
+pub type HbState = IterState<Vec<f64>, (), (), (), (), f64>;
+
+/// What every hbal solver records for its [`Solution`].
+#[derive(Debug, Clone, Default)]
+pub struct Progress {
+    /// The last iterate with a finite residual (real layout).
+    pub x: Vec<f64>,
+    /// Relative residual of every iterate, starting with the initial guess.
+    pub history: Vec<f64>,
+    /// A stop decided by the solver itself (divergence, singular matrix, ...).
+    pub termination: Option<Termination>,
+}
+
+impl Progress {
+    pub(crate) fn new(x0: Vec<f64>, max_iterations: usize) -> Self {
+        Self {
+            x: x0,
+            history: Vec::with_capacity(max_iterations + 2),
+            termination: None,
+        }
+    }
+
+    /// Records a solver-decided stop; argmin sees it as `SolverExit`.
+    pub(crate) fn stop(&mut self, state: HbState, why: Termination) -> HbState {
+        self.termination = Some(why);
+        state.terminate_with(TerminationReason::SolverExit(String::new()))
+    }
+}
+
+/// A solver that exposes its [`Progress`].
+pub trait HbSolver {
+    /// The recorded progress.
+    fn progress(&self) -> &Progress;
+}
+
+/// Common stopping limits.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Limits {
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    pub timeout: Option<Duration>,
+}
+
+/// Checks a relative tolerance.
+pub(crate) fn check_tolerance(context: &str, tolerance: f64) -> Result<()> {
+    if tolerance.is_finite() && (0.0..1.0).contains(&tolerance) {
+        Ok(())
+    } else {
+        Err(Error::invalid(context, "tolerance", tolerance, "in [0, 1)"))
+    }
+}
+
+/// The initial real unknowns: a warm start (checked), or else the linear frequency-domain
+/// solution `Z_k⁻¹ F_split,k` (the paper's step 0) if `linear` is set, or zero.
+pub(crate) fn initial_x(
+    hb: &HarmonicBalance,
+    initial: Option<&[Complex64]>,
+    linear: bool,
+) -> Result<Vec<f64>> {
+    let layout = hb.layout();
+    let mut x = vec![0.0; layout.len()];
+    if initial.is_none() && linear {
+        let mut q = hb.split_load().to_vec();
+        let n = layout.n;
+        for k in 0..=layout.h {
+            hb.dynamic_stiffness()
+                .solve_in_place(k, &mut q[k * n..(k + 1) * n]);
+        }
+        layout.pack(&q, &mut x);
+    }
+    if let Some(q) = initial {
+        if q.len() != hb.len() {
+            return Err(Error::DimensionMismatch {
+                context: "initial harmonics".into(),
+                expected: format!("{} ((H+1) * n)", hb.len()),
+                got: q.len().to_string(),
+            });
+        }
+        if !q.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "initial harmonics".into(),
+            });
+        }
+        layout.pack(q, &mut x);
+    }
+    Ok(x)
+}
+
+/// Runs `solver` on `hb` with argmin's executor and assembles the [`Solution`].
+pub(crate) fn run<S>(
+    hb: &HarmonicBalance,
+    ws: &mut Workspace,
+    solver: S,
+    limits: Limits,
+) -> Result<Solution>
+where
+    S: for<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> + HbSolver,
+{
+    let start = Instant::now();
+    let problem = HbProblem::new(hb, ws);
+    problem.reset_stats();
+    let mut executor = Executor::new(problem, solver)
+        .configure(|state| {
+            state
+                .max_iters(limits.max_iterations as u64)
+                .target_cost(limits.tolerance)
+                .counting(false)
+        })
+        .timer(false);
+    if let Some(t) = limits.timeout {
+        executor = executor.timeout(t);
+    }
+    let result = executor.run().map_err(|e| Error::Solver {
+        reason: e.to_string(),
+    })?;
+    let progress = result.solver.progress();
+    let termination = match result.state.get_termination_reason() {
+        Some(TerminationReason::TargetCostReached) | Some(TerminationReason::SolverConverged) => {
+            Termination::Converged
+        }
+        Some(TerminationReason::MaxItersReached) => Termination::MaxIterations,
+        Some(TerminationReason::Timeout) => Termination::Timeout,
+        Some(TerminationReason::Interrupt) => Termination::Interrupted,
+        _ => progress
+            .termination
+            .clone()
+            .unwrap_or(Termination::Interrupted),
+    };
+    let problem = result
+        .problem
+        .problem
+        .as_ref()
+        .ok_or_else(|| Error::Solver {
+            reason: "argmin returned no problem".into(),
+        })?;
+    let stats = problem.take_stats();
+    let mut harmonics = vec![Complex64::default(); hb.len()];
+    hb.layout().unpack(&progress.x, &mut harmonics);
+    Ok(Solution {
+        basis: *hb.basis(),
+        dofs: hb.model().dof_names().to_vec(),
+        harmonics,
+        termination,
+        history: progress.history.clone(),
+        stats,
+        wall_time: start.elapsed(),
+    })
+}
