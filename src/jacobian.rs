@@ -16,13 +16,23 @@ use crate::harmonic::{Part, RealLayout};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
+/// `ĝ_m` for `|m| < N` (always true here: `|k ± l| <= 2H < N`), without integer division.
 #[inline]
 fn bin(g: &[Complex64], samples: usize, m: i64) -> Complex64 {
-    let m = m.rem_euclid(samples as i64) as usize;
-    if m < g.len() {
-        g[m]
+    let (a, conj) = if m < 0 {
+        ((-m) as usize, true)
     } else {
-        g[samples - m].conj()
+        (m as usize, false)
+    };
+    let v = if a < g.len() {
+        g[a]
+    } else {
+        g[samples - a].conj()
+    };
+    if conj {
+        v.conj()
+    } else {
+        v
     }
 }
 
@@ -71,10 +81,17 @@ pub(crate) fn add_element_jacobian(
                     count += 1;
                 }
             }
-            for &(rb, cbk, v) in &entries[..count] {
-                for &(i, wi) in weights {
-                    for &(j, wj) in weights {
-                        jac[(rb * n + i, cbk * n + j)] += wi * wj * v;
+            if let [(i, wi)] = weights {
+                // One-DOF element: no weight products.
+                for &(rb, cbk, v) in &entries[..count] {
+                    jac[(rb * n + i, cbk * n + i)] += wi * wi * v;
+                }
+            } else {
+                for &(rb, cbk, v) in &entries[..count] {
+                    for &(i, wi) in weights {
+                        for &(j, wj) in weights {
+                            jac[(rb * n + i, cbk * n + j)] += wi * wj * v;
+                        }
                     }
                 }
             }

@@ -5,21 +5,34 @@
 use hbal::catalog::TwoShaft;
 use hbal::{FixedPoint, HarmonicBalance, HarmonicBasis};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+thread_local! {
+    /// Allocations made by this thread (the test harness allocates on other threads).
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+fn count_one() {
+    // `try_with`: the thread-local may be gone while a thread shuts down.
+    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count_one();
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count_one();
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
@@ -27,12 +40,8 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-/// The tests of this binary count a global number: run them one at a time.
-static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
 #[test]
 fn fixed_point_iterations_do_not_allocate() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let case = TwoShaft::new(60000.0);
     let model = case.model().unwrap();
     let hb =
@@ -43,9 +52,9 @@ fn fixed_point_iterations_do_not_allocate() {
             .with_tolerance(0.0)
             .unwrap()
             .with_max_iterations(iterations);
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        let before = allocations();
         let sol = solver.solve(&hb, ws).unwrap();
-        let after = ALLOCATIONS.load(Ordering::Relaxed);
+        let after = allocations();
         assert_eq!(sol.stats.iterations, iterations);
         assert_eq!(sol.stats.ffts, 3 * (iterations + 1));
         after - before
@@ -60,7 +69,6 @@ fn fixed_point_iterations_do_not_allocate() {
 /// (Newton reuses one Jacobian buffer for the matrix and its LU factors).
 #[test]
 fn anderson_and_newton_iterations_do_not_allocate() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let model = hbal::catalog::GearBacklash::default().model().unwrap();
     let hb = HarmonicBalance::new(&model, HarmonicBasis::new(0.7, 16).unwrap()).unwrap();
     let mut ws = hb.workspace();
@@ -82,9 +90,9 @@ fn anderson_and_newton_iterations_do_not_allocate() {
     };
     for (few, many) in methods(2).into_iter().zip(methods(8)) {
         let count = |m: hbal::Method, ws: &mut hbal::Workspace| {
-            let before = ALLOCATIONS.load(Ordering::Relaxed);
+            let before = allocations();
             let sol = m.solve(&hb, None, ws).unwrap();
-            let after = ALLOCATIONS.load(Ordering::Relaxed);
+            let after = allocations();
             (after - before, sol.stats.iterations)
         };
         let (a_few, it_few) = count(few, &mut ws);

@@ -3,8 +3,8 @@
 //! `J(x) dx = -R(x)` by dense LU (factored in the Jacobian's own buffer), then
 //! `x ← x + α dx` with the largest `α ∈ {1, ½, ¼, ...}` that satisfies the Armijo condition
 //! `‖R(x + α dx)‖ <= (1 - 10⁻⁴ α) ‖R(x)‖`: robust on non-smooth contact, where a full step can
-//! overshoot a contact edge. Each trial point is evaluated with its Jacobian (fused AFT), so an
-//! accepted trial needs no further evaluation.
+//! overshoot a contact edge. Trial points are evaluated without the Jacobian; the accepted one
+//! gets it (fused with its residual) only if another step follows.
 
 use super::lu;
 use super::problem::HbProblem;
@@ -193,13 +193,24 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
             for ((t, x), d) in self.x_trial.iter_mut().zip(&self.progress.x).zip(&self.dx) {
                 *t = x + alpha * d;
             }
-            let trial = p.residual(&self.x_trial, &mut self.r_trial, Some(&mut self.jac));
+            let trial = p.residual(&self.x_trial, &mut self.r_trial, None);
             if let Ok(rel) = trial {
                 if rel.is_finite() && rel <= (1.0 - 1e-4 * alpha) * self.rel {
                     std::mem::swap(&mut self.progress.x, &mut self.x_trial);
                     std::mem::swap(&mut self.r, &mut self.r_trial);
                     self.rel = rel;
                     self.progress.history.push(rel);
+                    // The Jacobian for the next step, unless this one is the last.
+                    if rel > self.options.tolerance {
+                        if let Err(e) =
+                            p.residual(&self.progress.x, &mut self.r, Some(&mut self.jac))
+                        {
+                            return Ok((
+                                self.progress.stop(state, nonfinite(&e.to_string())),
+                                None,
+                            ));
+                        }
+                    }
                     return Ok((state.cost(rel), None));
                 }
             }
