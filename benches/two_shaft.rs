@@ -1,7 +1,8 @@
 //! Performance targets of issue 2 (medians; compare ratios within one run):
 //! - two-shaft at 6000 rpm, H = 32, 3 fixed-point iterations, plans built beforehand: <= 20 µs;
 //! - HB cost flat across speed: 60000 rpm within 2x of 60 rpm;
-//! - speed-up over the time-domain reference at the same error at 60000 rpm.
+//! - speed-up over the time-domain reference at the same error at 60000 rpm;
+//! - issue 3: Newton on the backlash gear pair, H = 32, <= 50 µs per solve.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use hbal::catalog::TwoShaft;
@@ -63,5 +64,32 @@ fn time_domain(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, three_iterations, flat_across_speed, time_domain);
+/// Issue 3: Newton on the backlash gear pair (W = 0.7), 1 DOF, H = 32: <= 50 µs per solve; and
+/// every method on it.
+fn solvers_on_backlash(c: &mut Criterion) {
+    use hbal::{Anderson, Broyden, Method, Newton};
+    let model = hbal::catalog::GearBacklash::default().model().unwrap();
+    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(0.7, 32).unwrap()).unwrap();
+    let mut ws = hb.workspace();
+    let mut group = c.benchmark_group("backlash_W0.7_H32");
+    for method in [
+        Method::Newton(Newton::new()),
+        Method::Broyden(Broyden::new()),
+        Method::Anderson(Anderson::new()),
+    ] {
+        assert!(method.solve(&hb, None, &mut ws).unwrap().is_converged());
+        group.bench_function(method.name(), |b| {
+            b.iter(|| black_box(method.solve(&hb, None, &mut ws).unwrap()))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    three_iterations,
+    flat_across_speed,
+    time_domain,
+    solvers_on_backlash
+);
 criterion_main!(benches);

@@ -231,6 +231,10 @@ fn plots(
         };
         series.push(Series::line(label, revolution(&|t| it.displacement(0, t))));
     }
+    series.push(Series::line(
+        "HB converged",
+        revolution(&|t| converged.displacement(0, t)),
+    ));
     line_plot(
         &out.join(format!("two_shaft_{rpm}rpm_time.svg")),
         &format!("Two-shaft model at {rpm} rpm: q over one revolution"),

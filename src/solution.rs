@@ -75,6 +75,9 @@ pub struct Solution {
     /// Relative residual `‖R(Q)‖ / ‖F_ext‖` (Parseval norms; without a load
     /// `‖R‖ / max(‖Z Q‖, ‖F_rest‖)`) of every iterate, starting with the initial guess.
     pub history: Vec<f64>,
+    /// When each history entry was reached, in seconds since the solve started.
+    #[serde(default)]
+    pub history_seconds: Vec<f64>,
     /// Work counts.
     pub stats: SolveStats,
     /// Wall time of the solve (plans built beforehand).
@@ -107,12 +110,26 @@ impl Solution {
         self.history.last().copied().unwrap_or(f64::NAN)
     }
 
+    /// Index of a DOF by name.
+    pub fn dof_index(&self, name: &str) -> Option<usize> {
+        self.dofs.iter().position(|d| d == name)
+    }
+
     /// Complex harmonic `Q_k` of DOF `dof` (`a_k - i b_k`); zero above H.
+    ///
+    /// # Panics
+    /// If `dof` is not below the number of DOFs (as do all per-DOF accessors; look indices up
+    /// with [`Solution::dof_index`]).
     pub fn harmonic(&self, dof: usize, k: usize) -> Complex64 {
+        let n = self.dofs.len();
+        assert!(
+            dof < n,
+            "DOF index {dof} out of range: the model has {n} DOFs"
+        );
         if k > self.basis.harmonics() {
             return Complex64::default();
         }
-        self.harmonics[k * self.dofs.len() + dof]
+        self.harmonics[k * n + dof]
     }
 
     /// `(a_k, b_k)` of `a_k cos kθ + b_k sin kθ` for DOF `dof`.
@@ -120,7 +137,7 @@ impl Solution {
         cos_sin(self.harmonic(dof, k))
     }
 
-    /// `q_dof(θ)` at angle `θ = Ω t`.
+    /// `q_dof(θ)` at angle `θ = Ω t`. Panics as [`Solution::harmonic`].
     pub fn displacement(&self, dof: usize, theta: f64) -> f64 {
         (0..=self.basis.harmonics())
             .map(|k| (self.harmonic(dof, k) * Complex64::from_polar(1.0, k as f64 * theta)).re)

@@ -23,9 +23,21 @@ pub struct HarmonicBasis {
 }
 
 impl HarmonicBasis {
-    /// Ω in rad/s (finite, > 0) and H harmonics; N by default.
+    /// Largest accepted H (the Jacobian of a 1-DOF model already has `(2H+1)²` entries).
+    pub const MAX_HARMONICS: usize = 1 << 20;
+
+    /// Ω in rad/s (finite, > 0) and H harmonics (0 = static only, at most
+    /// [`HarmonicBasis::MAX_HARMONICS`]); N by default.
     pub fn new(omega: f64, harmonics: usize) -> Result<Self> {
         check_positive("harmonic basis", "omega", omega)?;
+        if harmonics > Self::MAX_HARMONICS {
+            return Err(Error::invalid(
+                "harmonic basis",
+                "harmonics",
+                harmonics as f64,
+                format!("<= {}", Self::MAX_HARMONICS),
+            ));
+        }
         let samples = (4 * harmonics + 1).next_power_of_two().max(8);
         Ok(Self {
             omega,
@@ -36,7 +48,7 @@ impl HarmonicBasis {
 
     /// Sets N (at least 2H+1; prefer small prime factors).
     pub fn with_samples(mut self, samples: usize) -> Result<Self> {
-        if samples < 2 * self.harmonics + 1 || samples < 2 {
+        if samples < 2 * self.harmonics + 1 || samples < 2 || samples > 64 * Self::MAX_HARMONICS {
             return Err(Error::TooFewSamples {
                 harmonics: self.harmonics,
                 samples,

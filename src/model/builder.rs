@@ -160,7 +160,7 @@ impl ModelBuilder {
             let mut w = Vec::with_capacity(weights.len());
             for (dof, wi) in &weights {
                 let i = index(&ctx, dof)?;
-                crate::error::check_finite(&ctx, &format!("weight of `{dof}`"), *wi)?;
+                crate::error::check_finite(&ctx, &format!("weights[{dof}]"), *wi)?;
                 if w.iter().any(|(j, _)| *j == i) {
                     return Err(Error::InvalidDofs {
                         reason: format!("{ctx} names DOF `{dof}` twice"),

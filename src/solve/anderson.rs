@@ -239,7 +239,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for AndersonSolver {
         match self.evaluate(p) {
             Ok(rel) => {
                 self.best = rel;
-                self.progress.history.push(rel);
+                self.progress.record(rel);
                 Ok((state.cost(rel), None))
             }
             Err(t) => Ok((self.progress.stop(state, t), None)),
@@ -276,7 +276,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for AndersonSolver {
                 return Ok((self.progress.stop(state, t), None));
             }
         };
-        self.progress.history.push(rel);
+        self.progress.record(rel);
         if rel > self.options.divergence_factor * self.best {
             self.progress.x.copy_from_slice(&self.x_prev);
             return Ok((self.progress.stop(state, Termination::Diverged), None));

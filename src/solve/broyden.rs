@@ -237,7 +237,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for BroydenSolver {
         let exact = self.options.initial_jacobian == InitialJacobian::Exact;
         let failed = self.reset_inverse(p, exact);
         if self.rel.is_finite() {
-            self.progress.history.push(self.rel);
+            self.progress.record(self.rel);
         }
         if let Some(t) = failed {
             return Ok((self.progress.stop(state, t), None));
@@ -281,7 +281,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for BroydenSolver {
         };
         self.rel = rel;
         self.fresh = false;
-        self.progress.history.push(rel);
+        self.progress.record(rel);
         // B y and sᵀ B.
         let b = self.inverse.as_slice();
         self.by.fill(0.0);

@@ -160,7 +160,7 @@ impl FixedPointSolver {
     fn evaluate(&mut self, problem: &HbProblem, state: HbState) -> HbState {
         match problem.fixed_point_map(&self.progress.x, &mut self.g) {
             Ok(rel) if rel.is_finite() && self.g.iter().all(|v| v.is_finite()) => {
-                self.progress.history.push(rel);
+                self.progress.record(rel);
                 self.best = self.best.min(rel);
                 state.cost(rel)
             }

@@ -156,7 +156,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
         match p.residual(&self.progress.x, &mut self.r, Some(&mut self.jac)) {
             Ok(rel) if rel.is_finite() => {
                 self.rel = rel;
-                self.progress.history.push(rel);
+                self.progress.record(rel);
                 Ok((state.cost(rel), None))
             }
             Ok(_) => Ok((self.progress.stop(state, nonfinite("residual")), None)),
@@ -199,7 +199,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
                     std::mem::swap(&mut self.progress.x, &mut self.x_trial);
                     std::mem::swap(&mut self.r, &mut self.r_trial);
                     self.rel = rel;
-                    self.progress.history.push(rel);
+                    self.progress.record(rel);
                     // The Jacobian for the next step, unless this one is the last.
                     if rel > self.options.tolerance {
                         if let Err(e) =

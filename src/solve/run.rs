@@ -19,8 +19,11 @@ pub struct Progress {
     pub x: Vec<f64>,
     /// Relative residual of every iterate, starting with the initial guess.
     pub history: Vec<f64>,
+    /// Seconds since the start of the solve at which each history entry was recorded.
+    pub seconds: Vec<f64>,
     /// A stop decided by the solver itself (divergence, singular matrix, ...).
     pub termination: Option<Termination>,
+    start: Option<Instant>,
 }
 
 impl Progress {
@@ -28,8 +31,17 @@ impl Progress {
         Self {
             x: x0,
             history: Vec::with_capacity(max_iterations + 2),
+            seconds: Vec::with_capacity(max_iterations + 2),
             termination: None,
+            start: Some(Instant::now()),
         }
+    }
+
+    /// Records the relative residual of a new iterate and when it was reached.
+    pub(crate) fn record(&mut self, residual: f64) {
+        self.history.push(residual);
+        let t = self.start.map_or(0.0, |s| s.elapsed().as_secs_f64());
+        self.seconds.push(t);
     }
 
     /// Records a solver-decided stop; argmin sees it as `SolverExit`.
@@ -154,6 +166,7 @@ where
         harmonics,
         termination,
         history: progress.history.clone(),
+        history_seconds: progress.seconds.clone(),
         stats,
         wall_time: start.elapsed(),
     })
