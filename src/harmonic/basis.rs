@@ -48,7 +48,7 @@ impl HarmonicBasis {
 
     /// Sets N (at least 2H+1; prefer small prime factors).
     pub fn with_samples(mut self, samples: usize) -> Result<Self> {
-        if samples < 2 * self.harmonics + 1 || samples < 2 || samples > 64 * Self::MAX_HARMONICS {
+        if samples < 2 * self.harmonics + 1 || !(2..=64 * Self::MAX_HARMONICS).contains(&samples) {
             return Err(Error::TooFewSamples {
                 harmonics: self.harmonics,
                 samples,
