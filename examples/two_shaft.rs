@@ -9,7 +9,7 @@ use hbal::catalog::TwoShaft;
 use hbal::compare::relative_error;
 use hbal::report::{line_plot, median_time, Axis, Series};
 use hbal::timesim::{TimeResponse, TimeSimulation};
-use hbal::{FixedPoint, HarmonicBalance, HarmonicBasis, Solution, Termination};
+use hbal::{Anderson, FixedPoint, HarmonicBalance, HarmonicBasis, Method, Solution, Termination};
 use std::f64::consts::TAU;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -122,10 +122,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// periods agree to 1e-6; HB takes the smallest H (N = 16H) whose error is at most the
 /// time-domain run's (or 1e-6).
 fn speed_up_table(budget: Duration) -> Result<(), Box<dyn std::error::Error>> {
-    println!("\nSame error: TD (rtol 1e-8) until successive periods agree to 1e-6; HB (fixed point, gamma 0, else 0.5; residual 1e-10)");
+    println!("\nSame error: TD (rtol 1e-8) until successive periods agree to 1e-6; HB (fastest of fixed point γ=0, Anderson, fixed point γ=0.5; residual 1e-10)");
     println!("with the smallest H in 32..512 (N = 16H) whose error is at most max(TD err, 1e-6).");
     println!("err against a converged time-domain reference (rtol 1e-12, periodicity 1e-10), mesh harmonics 0..={H_COMPARE}.\n");
-    println!("| rpm | TD wall | TD periods | TD err | HB H | HB wall | HB iterations (gamma) | HB err | speed-up |");
+    println!("| rpm | TD wall | TD periods | TD err | HB H | HB wall | HB iterations (method) | HB err | speed-up |");
     println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for rpm in [60.0, 600.0, 6000.0, 60000.0] {
         let case = TwoShaft::new(rpm);
@@ -154,28 +154,46 @@ fn speed_up_table(budget: Duration) -> Result<(), Box<dyn std::error::Error>> {
             let basis = HarmonicBasis::new(case.mesh_omega(), h)?.with_samples(16 * h)?;
             let hb = HarmonicBalance::new(&model, basis)?;
             let mut ws = hb.workspace();
-            for gamma in [0.0, 0.5] {
-                let solver = FixedPoint::new()
-                    .with_gamma(gamma)?
-                    .with_max_iterations(2000);
-                let (wall, sol) = median_time(budget, || solver.solve(&hb, &mut ws));
+            // The fastest converged of: the paper's iteration, Anderson, relaxed fixed point.
+            let mut fastest: Option<(String, Duration, Solution, f64)> = None;
+            for (label, method) in [
+                (
+                    "fixed point γ=0",
+                    Method::FixedPoint(FixedPoint::new().with_max_iterations(2000)),
+                ),
+                (
+                    "anderson",
+                    Method::Anderson(Anderson::new().with_max_iterations(2000)),
+                ),
+                (
+                    "fixed point γ=0.5",
+                    Method::FixedPoint(
+                        FixedPoint::new().with_gamma(0.5)?.with_max_iterations(2000),
+                    ),
+                ),
+            ] {
+                let (wall, sol) = median_time(budget, || method.solve(&hb, None, &mut ws));
                 let sol = sol?;
                 if sol.termination != Termination::Converged {
-                    last = format!("H {h}: {} (gamma {gamma})", sol.termination);
+                    last = format!("H {h}: {} ({label})", sol.termination);
                     continue;
                 }
                 let err = relative_error(sol.harmonics(), &reference.harmonics, 1, H_COMPARE);
                 last = format!("H {h}: err {err:.2e}");
+                if fastest.as_ref().is_none_or(|f| wall < f.1) {
+                    fastest = Some((label.to_string(), wall, sol, err));
+                }
+            }
+            if let Some((label, wall, sol, err)) = fastest {
                 if err <= target {
-                    row = Some((h, gamma, wall, sol, err));
+                    row = Some((h, label, wall, sol, err));
                     break 'search;
                 }
-                break;
             }
         }
         match row {
-            Some((h, gamma, wall, sol, err)) => println!(
-                "| {rpm} | {} | {} | {td_err:.2e} | {h} | {} | {} ({gamma}) | {err:.2e} | {:.2}x |",
+            Some((h, label, wall, sol, err)) => println!(
+                "| {rpm} | {} | {} | {td_err:.2e} | {h} | {} | {} ({label}) | {err:.2e} | {:.2}x |",
                 fmt(td_wall),
                 td.periods,
                 fmt(wall),
