@@ -269,3 +269,77 @@ fn acceleration_where_the_fixed_point_converges() {
         }
     }
 }
+
+/// Bad input for the accelerated solvers: options out of range are errors; a singular Newton
+/// matrix and a non-finite Jacobian are terminations that keep the last good iterate.
+#[test]
+fn accelerated_solver_bad_input() {
+    assert!(Newton::new().with_tolerance(1.5).is_err());
+    assert!(Broyden::new().with_tolerance(-1.0).is_err());
+    assert!(Anderson::new().with_tolerance(f64::NAN).is_err());
+    assert!(Anderson::new().with_depth(0).is_err());
+    assert!(Anderson::new().with_gamma(1.0).is_err());
+
+    /// A force that is identically zero while claiming a linear part: the Jacobian loses K0.
+    #[derive(Debug, serde::Serialize, serde::Deserialize)]
+    struct Dead {
+        nan_derivative: bool,
+    }
+    #[typetag::serde(name = "test_dead")]
+    impl hbal::force::ForceLaw for Dead {
+        fn force(&self, _t: f64, _u: f64, _du: f64) -> f64 {
+            0.0
+        }
+        fn derivatives(&self, _t: f64, _u: f64, _du: f64) -> (f64, f64) {
+            if self.nan_derivative {
+                (f64::NAN, 0.0)
+            } else {
+                (0.0, 0.0)
+            }
+        }
+        fn linear_part(&self) -> hbal::force::LinearPart {
+            hbal::force::LinearPart {
+                stiffness: 1.0,
+                ..Default::default()
+            }
+        }
+    }
+    for (nan, expected) in [
+        (false, Termination::SingularJacobian),
+        (
+            true,
+            Termination::NonFinite {
+                what: String::new(),
+            },
+        ),
+    ] {
+        let model = Model::builder(&["x"])
+            .mass_diagonal(&[1.0])
+            .damping(DMatrix::from_element(1, 1, 0.1))
+            .element(
+                "dead",
+                &[("x", 1.0)],
+                Dead {
+                    nan_derivative: nan,
+                },
+            )
+            .load("x", 0, 1.0, 0.0)
+            .load("x", 1, 0.5, 0.0)
+            .build()
+            .unwrap();
+        let hb = HarmonicBalance::new(&model, HarmonicBasis::new(2.0, 4).unwrap()).unwrap();
+        let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
+        assert_eq!(
+            std::mem::discriminant(&sol.termination),
+            std::mem::discriminant(&expected),
+            "{}",
+            sol.termination
+        );
+        assert!(sol
+            .harmonics()
+            .iter()
+            .all(|q| q.re.is_finite() && q.im.is_finite()));
+        // The kept iterate is the linear start: static part F0 / K0 = 1.
+        assert!((sol.cos_sin(0, 0).0 - 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,126 @@
+//! Speed against error: harmonic balance with H = 4 ... 256 and the time-domain reference with
+//! rtol = 1e-4 ... 1e-12, both against a converged time-domain reference (rtol 1e-12 run to a
+//! periodicity of 1e-11 from a start on the orbit). Tells how many harmonics a scene needs for a
+//! given error, next to the truncation estimate every solution reports.
+//!
+//! Run: `cargo run --release --example accuracy [-- --out DIR]`
+
+use hbal::catalog::{GearBacklash, TwoShaft};
+use hbal::compare::relative_error;
+use hbal::report::{line_plot, median_time, Axis, Series};
+use hbal::timesim::TimeSimulation;
+use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// Harmonics compared (orders above a solution's H count as zero there).
+const H_COMPARE: usize = 32;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let out = args
+        .iter()
+        .position(|a| a == "--out")
+        .and_then(|i| args.get(i + 1))
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("out"));
+    std::fs::create_dir_all(&out)?;
+    let shaft = TwoShaft::new(6000.0);
+    let cases: Vec<(&str, &str, Model, f64, Option<(Vec<f64>, Vec<f64>)>)> = vec![
+        (
+            "two_shaft_6000rpm",
+            "two-shaft model, 6000 rpm",
+            shaft.model()?,
+            shaft.mesh_omega(),
+            None,
+        ),
+        (
+            "backlash_W1.0",
+            "gear pair with backlash, W 1.0 (contact loss)",
+            GearBacklash::default().model()?,
+            1.0,
+            Some((vec![1.1], vec![0.0])),
+        ),
+    ];
+    let budget = Duration::from_millis(150);
+    for (file, title, model, omega, initial) in &cases {
+        let reference = TimeSimulation {
+            rtol: 1e-12,
+            steady_tolerance: 1e-11,
+            samples: 4096,
+            initial: initial.clone(),
+            ..TimeSimulation::default()
+        }
+        .run(model, *omega)?;
+        println!("\n{title}: error = relative RMS distance over harmonics 0..={H_COMPARE} to the converged time-domain reference\n");
+        println!("| solver | setting | wall | error | truncation estimate |");
+        println!("|---|---|---:|---:|---:|");
+        let mut hb_points = Vec::new();
+        let mut needed: Vec<(f64, Option<usize>)> = vec![(1e-2, None), (1e-4, None), (1e-6, None)];
+        for h in [4usize, 8, 16, 32, 64, 128, 256] {
+            let hb = HarmonicBalance::new(model, HarmonicBasis::new(*omega, h)?)?;
+            let mut ws = hb.workspace();
+            let newton = Newton::new().with_tolerance(1e-12)?;
+            let (wall, sol) = median_time(budget, || newton.solve(&hb, &mut ws));
+            let sol = sol?;
+            let err = relative_error(sol.harmonics(), &reference.harmonics, 1, H_COMPARE);
+            let status = if sol.is_converged() {
+                String::new()
+            } else {
+                format!(" ({})", sol.termination)
+            };
+            println!(
+                "| HB (Newton) | H = {h}, N = {}{status} | {:.1} µs | {err:.2e} | {:.1e} |",
+                hb.basis().samples(),
+                wall.as_secs_f64() * 1e6,
+                sol.truncation_estimate()
+            );
+            if sol.is_converged() {
+                hb_points.push((wall.as_secs_f64() * 1e6, err));
+                for (target, n) in needed.iter_mut() {
+                    if n.is_none() && err <= *target {
+                        *n = Some(h);
+                    }
+                }
+            }
+        }
+        let mut td_points = Vec::new();
+        for rtol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
+            let sim = TimeSimulation {
+                rtol,
+                steady_tolerance: (10.0 * rtol).max(1e-10),
+                samples: 4096,
+                initial: initial.clone(),
+                ..TimeSimulation::default()
+            };
+            let (_, td) = median_time(budget, || sim.run(model, *omega));
+            let td = td?;
+            let err = relative_error(&td.harmonics, &reference.harmonics, 1, H_COMPARE);
+            println!(
+                "| time domain | rtol = {rtol:.0e}, {} periods, {:?} | {:.1} µs | {err:.2e} | |",
+                td.periods,
+                td.stop,
+                td.wall_time.as_secs_f64() * 1e6
+            );
+            td_points.push((td.wall_time.as_secs_f64() * 1e6, err));
+        }
+        for (target, n) in &needed {
+            match n {
+                Some(h) => println!("\nError <= {target:.0e} needs H >= {h} (of 4, 8, ..., 256)."),
+                None => println!("\nError <= {target:.0e} is not reached with H <= 256."),
+            }
+        }
+        line_plot(
+            &out.join(format!("accuracy_{file}.svg")),
+            &format!("Error against wall time: {title}"),
+            &Axis::log("wall time (µs)"),
+            &Axis::log("relative error"),
+            &[
+                Series::line("harmonic balance, H = 4 ... 256", hb_points),
+                Series::line("time domain, rtol = 1e-4 ... 1e-12", td_points),
+            ],
+        )?;
+    }
+    println!("\nSVG plots written to {}/", out.display());
+    Ok(())
+}
