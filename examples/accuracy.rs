@@ -13,6 +13,15 @@ use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
 use std::path::PathBuf;
 use std::time::Duration;
 
+/// A case: file stem, title, model, fundamental, initial state of the time integration.
+type Case = (
+    &'static str,
+    &'static str,
+    Model,
+    f64,
+    Option<(Vec<f64>, Vec<f64>)>,
+);
+
 /// Harmonics compared (orders above a solution's H count as zero there).
 const H_COMPARE: usize = 32;
 
@@ -26,7 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or_else(|| PathBuf::from("out"));
     std::fs::create_dir_all(&out)?;
     let shaft = TwoShaft::new(6000.0);
-    let cases: Vec<(&str, &str, Model, f64, Option<(Vec<f64>, Vec<f64>)>)> = vec![
+    let cases: Vec<Case> = vec![
         (
             "two_shaft_6000rpm",
             "two-shaft model, 6000 rpm",
