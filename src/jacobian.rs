@@ -36,6 +36,25 @@ fn bin(g: &[Complex64], samples: usize, m: i64) -> Complex64 {
     }
 }
 
+/// Scratch of the assembly: the bins `ĝ_m`, `m = -H..=2H`, of both derivatives, and one local
+/// column.
+#[derive(Debug, Clone)]
+pub(crate) struct JacobianScratch {
+    ext_u: Vec<Complex64>,
+    ext_du: Vec<Complex64>,
+    column: Vec<f64>,
+}
+
+impl JacobianScratch {
+    pub(crate) fn new(h: usize) -> Self {
+        Self {
+            ext_u: vec![Complex64::default(); 3 * h + 1],
+            ext_du: vec![Complex64::default(); 3 * h + 1],
+            column: vec![0.0; 2 * h + 1],
+        }
+    }
+}
+
 /// `jac += (w wᵀ) ⊗ L` for one element, from the DFT bins of its derivative samples.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn add_element_jacobian(
@@ -47,50 +66,64 @@ pub(crate) fn add_element_jacobian(
     weights: &[(usize, f64)],
     n: usize,
     jac: &mut DMatrix<f64>,
+    scratch: &mut JacobianScratch,
 ) {
-    let half_i = Complex64::new(0.0, -0.5); // 1/(2i)
+    for (i, (eu, ed)) in scratch
+        .ext_u
+        .iter_mut()
+        .zip(scratch.ext_du.iter_mut())
+        .enumerate()
+    {
+        let m = i as i64 - h as i64;
+        *eu = bin(spec_u, samples, m);
+        *ed = bin(spec_du, samples, m);
+    }
+    let rows = jac.nrows();
+    let data = jac.as_mut_slice(); // column-major
     for l in 0..=h {
         let lw = l as f64 * omega;
-        for k in 0..=h {
-            let (km, kp) = (k as i64 - l as i64, (k + l) as i64);
-            let (um, up) = (bin(spec_u, samples, km), bin(spec_u, samples, kp));
-            let (dm, dp) = (bin(spec_du, samples, km), bin(spec_du, samples, kp));
-            let col_a = (um + up) * 0.5 - (dm - dp) * half_i * lw;
-            let col_b = (um - up) * half_i + (dm + dp) * (0.5 * lw);
-            let scale = if k == 0 { 1.0 } else { 2.0 };
-            let row_a = RealLayout::block(k, Part::Cos);
-            let row_b = RealLayout::block(k, Part::Sin);
-            let ca = RealLayout::block(l, Part::Cos);
-            let cb = RealLayout::block(l, Part::Sin);
-            let mut entries = [
-                (row_a, ca, scale * col_a.re),
-                (0, 0, 0.0),
-                (0, 0, 0.0),
-                (0, 0, 0.0),
-            ];
-            let mut count = 1;
-            if k > 0 {
-                entries[count] = (row_b, ca, -2.0 * col_a.im);
-                count += 1;
+        for part in [Part::Cos, Part::Sin] {
+            if l == 0 && part == Part::Sin {
+                continue;
             }
-            if l > 0 {
-                entries[count] = (row_a, cb, scale * col_b.re);
-                count += 1;
-                if k > 0 {
-                    entries[count] = (row_b, cb, -2.0 * col_b.im);
-                    count += 1;
+            // Local column of a_l or b_l: rows a_k, b_k for k = 0..=H.
+            for k in 0..=h {
+                // ĝ_{k-l} at index k - l + H, ĝ_{k+l} at index k + l + H.
+                let (um, up) = (scratch.ext_u[k + h - l], scratch.ext_u[k + l + h]);
+                let (dm, dp) = (scratch.ext_du[k + h - l], scratch.ext_du[k + l + h]);
+                // a_l: (ĝu_- + ĝu_+)/2 + i lΩ (ĝu̇_- - ĝu̇_+)/2;
+                // b_l: -i (ĝu_- - ĝu_+)/2 + lΩ (ĝu̇_- + ĝu̇_+)/2.
+                let d = match part {
+                    Part::Cos => {
+                        let s = um + up;
+                        let t = dm - dp;
+                        Complex64::new(0.5 * (s.re - lw * t.im), 0.5 * (s.im + lw * t.re))
+                    }
+                    Part::Sin => {
+                        let s = um - up;
+                        let t = dp + dm;
+                        Complex64::new(0.5 * (s.im + lw * t.re), 0.5 * (-s.re + lw * t.im))
+                    }
+                };
+                if k == 0 {
+                    scratch.column[0] = d.re;
+                } else {
+                    scratch.column[2 * k - 1] = 2.0 * d.re;
+                    scratch.column[2 * k] = -2.0 * d.im;
                 }
             }
-            if let [(i, wi)] = weights {
-                // One-DOF element: no weight products.
-                for &(rb, cbk, v) in &entries[..count] {
-                    jac[(rb * n + i, cbk * n + i)] += wi * wi * v;
-                }
-            } else {
-                for &(rb, cbk, v) in &entries[..count] {
-                    for &(i, wi) in weights {
-                        for &(j, wj) in weights {
-                            jac[(rb * n + i, cbk * n + j)] += wi * wj * v;
+            let cb = RealLayout::block(l, part);
+            for &(j, wj) in weights {
+                let col = &mut data[(cb * n + j) * rows..(cb * n + j + 1) * rows];
+                for &(i, wi) in weights {
+                    let w = wi * wj;
+                    if n == 1 {
+                        for (x, c) in col.iter_mut().zip(&scratch.column) {
+                            *x += w * c;
+                        }
+                    } else {
+                        for (r, c) in scratch.column.iter().enumerate() {
+                            col[r * n + i] += w * c;
                         }
                     }
                 }

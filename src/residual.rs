@@ -54,6 +54,7 @@ pub struct AftBuffers {
     gdu: Vec<f64>,
     spec_u: Vec<Complex64>,
     spec_du: Vec<Complex64>,
+    jac_scratch: crate::jacobian::JacobianScratch,
     /// Real FFTs done so far.
     pub ffts: usize,
     /// Force-law calls so far.
@@ -208,6 +209,7 @@ impl<'m> HarmonicBalance<'m> {
                 gdu: vec![0.0; s],
                 spec_u: vec![Complex64::default(); s / 2 + 1],
                 spec_du: vec![Complex64::default(); s / 2 + 1],
+                jac_scratch: crate::jacobian::JacobianScratch::new(h),
                 ffts: 0,
                 force_evaluations: 0,
             },
@@ -310,6 +312,7 @@ impl<'m> HarmonicBalance<'m> {
                     e.weights(),
                     n,
                     jac,
+                    &mut ws.jac_scratch,
                 );
             }
         }

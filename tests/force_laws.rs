@@ -120,6 +120,39 @@ fn rectangular_mesh_values_mean_and_jumps() {
     }
 }
 
+/// Batch evaluation (with the cosine recurrence on equidistant angles) equals pointwise
+/// evaluation for every built-in law, over several blocks of 64.
+#[test]
+fn batch_evaluation_matches_pointwise() {
+    let n = 300;
+    let uniform: Vec<f64> = (0..n)
+        .map(|j| std::f64::consts::TAU * j as f64 / n as f64)
+        .collect();
+    let ragged: Vec<f64> = (0..n)
+        .map(|j| 0.02 * j as f64 + 0.001 * (j as f64).sin())
+        .collect();
+    for theta in [uniform, ragged] {
+        let u: Vec<f64> = theta.iter().map(|t| 2.5 * (1.3 * t).sin()).collect();
+        let du: Vec<f64> = theta.iter().map(|t| (0.7 * t).cos()).collect();
+        for law in laws() {
+            let mut out = vec![0.0; n];
+            let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+            law.force_batch(&theta, &u, &du, &mut out);
+            law.derivatives_batch(&theta, &u, &du, &mut a, &mut b);
+            for j in 0..n {
+                let f = law.force(theta[j], u[j], du[j]);
+                let (da, db) = law.derivatives(theta[j], u[j], du[j]);
+                assert!(
+                    (out[j] - f).abs() <= 1e-13 * f.abs().max(1.0),
+                    "{law:?} sample {j}"
+                );
+                assert!((a[j] - da).abs() <= 1e-13 * da.abs().max(1.0));
+                assert!((b[j] - db).abs() <= 1e-13 * db.abs().max(1.0));
+            }
+        }
+    }
+}
+
 #[test]
 fn backlash_dead_zone() {
     let b = Backlash::new(1.0, MeshProfile::Constant { stiffness: 2.0 }).with_contact_damping(0.5);

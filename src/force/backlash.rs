@@ -101,6 +101,43 @@ impl ForceLaw for Backlash {
         let k = self.stiffness.value(self.teeth as f64 * theta + self.phase);
         k * gap + self.contact_damping * du
     }
+    fn force_batch(&self, theta: &[f64], u: &[f64], du: &[f64], out: &mut [f64]) {
+        let mut k = [0.0; 64];
+        let b = self.half_backlash;
+        for (start, t) in (0..theta.len()).step_by(64).zip(theta.chunks(64)) {
+            self.stiffness
+                .values_into(self.teeth as f64, self.phase, t, &mut k);
+            for (j, kj) in k[..t.len()].iter().enumerate() {
+                let (x, v) = (u[start + j], du[start + j]);
+                out[start + j] = if x > b {
+                    kj * (x - b) + self.contact_damping * v
+                } else if x < -b {
+                    kj * (x + b) + self.contact_damping * v
+                } else {
+                    0.0
+                };
+            }
+        }
+    }
+    fn derivatives_batch(
+        &self,
+        theta: &[f64],
+        u: &[f64],
+        _du: &[f64],
+        dfdu: &mut [f64],
+        dfddu: &mut [f64],
+    ) {
+        let mut k = [0.0; 64];
+        for (start, t) in (0..theta.len()).step_by(64).zip(theta.chunks(64)) {
+            self.stiffness
+                .values_into(self.teeth as f64, self.phase, t, &mut k);
+            for (j, kj) in k[..t.len()].iter().enumerate() {
+                let engaged = u[start + j].abs() > self.half_backlash;
+                dfdu[start + j] = if engaged { *kj } else { 0.0 };
+                dfddu[start + j] = if engaged { self.contact_damping } else { 0.0 };
+            }
+        }
+    }
     #[inline]
     fn derivatives(&self, theta: f64, u: f64, _du: f64) -> (f64, f64) {
         if u.abs() > self.half_backlash {

@@ -92,9 +92,13 @@ impl ForceLaw for MeshStiffness {
                 }
             }
             (profile, damping) => {
-                for (((o, &t), &x), &v) in samples {
-                    let k = profile.value(z * t + self.phase);
-                    *o = k * x + damping.value(k) * v;
+                let _ = samples;
+                let mut k = [0.0; 64];
+                for (start, t) in (0..theta.len()).step_by(64).zip(theta.chunks(64)) {
+                    profile.values_into(z, self.phase, t, &mut k);
+                    for (j, kj) in k[..t.len()].iter().enumerate() {
+                        out[start + j] = kj * u[start + j] + damping.value(*kj) * du[start + j];
+                    }
                 }
             }
         }
