@@ -61,6 +61,7 @@ pub mod jacobian;
 pub mod model;
 pub mod report;
 pub mod residual;
+pub mod scene;
 pub mod solution;
 pub mod solve;
 pub mod timesim;

@@ -1,0 +1,380 @@
+//! The `hbal` command line: solve, compare and check scene files.
+//!
+//! Exit codes: 0 success, 1 a solve that did not converge (its partial result is still
+//! reported and written), 2 bad input (the message names the file and the field).
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use hbal::compare::relative_error;
+use hbal::report::{line_plot, Axis, Series};
+use hbal::scene::{method_named, Scene};
+use hbal::timesim::TimeSimulation;
+use hbal::{HarmonicBalance, HarmonicBasis, Method, Solution};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(
+    name = "hbal",
+    version,
+    about = "Harmonic balance for powertrains: periodic steady state of gear meshes, backlash and user force laws"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve a scene: summary, CSV of harmonics and time series, SVG plots.
+    Solve {
+        /// Scene file (.toml or .json).
+        scene: PathBuf,
+        /// Solver: fixed_point, newton, broyden, anderson (default: the scene's).
+        #[arg(long)]
+        method: Option<String>,
+        /// Number of harmonics H (default: the scene's).
+        #[arg(long)]
+        harmonics: Option<usize>,
+        /// Print exactly one JSON object on stdout instead of the summary.
+        #[arg(long)]
+        json: bool,
+        /// Write harmonics.csv, time_series.csv and SVG plots into this directory.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Every solver and the time-domain reference on one scene.
+    Compare {
+        /// Scene file (.toml or .json).
+        scene: PathBuf,
+        /// Print exactly one JSON object on stdout instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Write an SVG of the residual histories into this directory.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Validate a scene without solving.
+    Check {
+        /// Scene file (.toml or .json).
+        scene: PathBuf,
+    },
+}
+
+/// An error with its exit code.
+struct Failure {
+    code: u8,
+    error: anyhow::Error,
+}
+
+impl<E: Into<anyhow::Error>> From<E> for Failure {
+    fn from(e: E) -> Self {
+        Failure {
+            code: 2,
+            error: e.into(),
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Solve {
+            scene,
+            method,
+            harmonics,
+            json,
+            out,
+        } => solve(&scene, method.as_deref(), harmonics, json, out.as_deref()),
+        Command::Compare { scene, json, out } => compare(&scene, json, out.as_deref()),
+        Command::Check { scene } => check(&scene),
+    };
+    match result {
+        Ok(code) => ExitCode::from(code),
+        Err(f) => {
+            eprintln!("error: {:#}", f.error);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+/// Loads the scene and applies the command-line overrides.
+fn load(path: &Path, method: Option<&str>, harmonics: Option<usize>) -> Result<Scene, Failure> {
+    let mut scene = Scene::load(path)?;
+    if let Some(name) = method {
+        let text = std::fs::read_to_string(path)?;
+        scene.method = method_named(&text, &scene.file, name)?;
+    }
+    if let Some(h) = harmonics {
+        scene.basis = HarmonicBasis::new(scene.basis.omega(), h)
+            .with_context(|| format!("{}: --harmonics", scene.file))?;
+    }
+    Ok(scene)
+}
+
+fn check(path: &Path) -> Result<u8, Failure> {
+    let scene = load(path, None, None)?;
+    HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
+    println!(
+        "{}: ok ({} DOFs, {} elements, Ω = {:.6} rad/s, H = {}, N = {}, solver {})",
+        scene.file,
+        scene.model.n_dofs(),
+        scene.model.elements().len(),
+        scene.basis.omega(),
+        scene.basis.harmonics(),
+        scene.basis.samples(),
+        scene.method.name()
+    );
+    Ok(0)
+}
+
+fn solve(
+    path: &Path,
+    method: Option<&str>,
+    harmonics: Option<usize>,
+    as_json: bool,
+    out: Option<&Path>,
+) -> Result<u8, Failure> {
+    let scene = load(path, method, harmonics)?;
+    let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
+    let mut ws = hb.workspace();
+    let start = Instant::now();
+    let sol = scene.method.solve(&hb, None, &mut ws)?;
+    let solve_seconds = start.elapsed().as_secs_f64();
+    let dofs: Vec<_> = sol
+        .dof_names()
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            json!({
+                "name": name,
+                "max_abs": sol.max_abs(i),
+                "harmonics": (0..=sol.basis().harmonics()).map(|k| {
+                    let (c, s) = sol.cos_sin(i, k);
+                    json!({"order": k, "cos": c, "sin": s})
+                }).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    if as_json {
+        let doc = json!({
+            "converged": sol.is_converged(),
+            "termination": sol.termination.to_string(),
+            "method": scene.method.name(),
+            "iterations": sol.stats.iterations,
+            "residual": sol.residual(),
+            "fundamental_rad_s": sol.basis().omega(),
+            "harmonics": sol.basis().harmonics(),
+            "samples": sol.basis().samples(),
+            "solve_seconds": solve_seconds,
+            "dofs": dofs,
+            "history": sol.history,
+        });
+        println!("{doc}");
+    } else {
+        println!(
+            "{}: {} ({}) after {} iterations, relative residual {:.2e}, solve {:.3} ms",
+            scene.file,
+            sol.termination,
+            scene.method.name(),
+            sol.stats.iterations,
+            sol.residual(),
+            solve_seconds * 1e3
+        );
+        println!(
+            "  fundamental {:.6} rad/s, H = {}, N = {}, truncation estimate {:.1e}",
+            sol.basis().omega(),
+            sol.basis().harmonics(),
+            sol.basis().samples(),
+            sol.truncation_estimate()
+        );
+        for (i, name) in sol.dof_names().iter().enumerate() {
+            println!("  max |q| {name}: {:.6e}", sol.max_abs(i));
+        }
+    }
+    if let Some(dir) = out {
+        write_outputs(dir, &sol)?;
+        if !as_json {
+            println!(
+                "  wrote harmonics.csv, time_series.csv, time_series.svg, spectrum.svg to {}",
+                dir.display()
+            );
+        }
+    }
+    Ok(if sol.is_converged() { 0 } else { 1 })
+}
+
+fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let h = sol.basis().harmonics();
+    let mut csv = String::from("dof,order,cos,sin\n");
+    for (i, name) in sol.dof_names().iter().enumerate() {
+        for k in 0..=h {
+            let (c, s) = sol.cos_sin(i, k);
+            csv.push_str(&format!("{name},{k},{c:e},{s:e}\n"));
+        }
+    }
+    std::fs::write(dir.join("harmonics.csv"), csv)?;
+    let points = sol.basis().samples().max(256);
+    let period = sol.basis().period();
+    let series: Vec<Vec<f64>> = (0..sol.dof_names().len())
+        .map(|i| sol.time_series(i, points))
+        .collect();
+    let mut csv = String::from("t,theta");
+    for name in sol.dof_names() {
+        csv.push_str(&format!(",{name}"));
+    }
+    csv.push('\n');
+    for j in 0..points {
+        let frac = j as f64 / points as f64;
+        csv.push_str(&format!(
+            "{:e},{:e}",
+            frac * period,
+            frac * std::f64::consts::TAU
+        ));
+        for s in &series {
+            csv.push_str(&format!(",{:e}", s[j]));
+        }
+        csv.push('\n');
+    }
+    std::fs::write(dir.join("time_series.csv"), csv)?;
+    let lines: Vec<Series> = sol
+        .dof_names()
+        .iter()
+        .zip(&series)
+        .map(|(name, s)| {
+            Series::line(
+                name.clone(),
+                s.iter()
+                    .enumerate()
+                    .map(|(j, v)| (j as f64 / points as f64 * period, *v))
+                    .collect(),
+            )
+        })
+        .collect();
+    line_plot(
+        &dir.join("time_series.svg"),
+        "Periodic solution over one period",
+        &Axis::linear("t (s)"),
+        &Axis::linear("q"),
+        &lines,
+    )
+    .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    let spectra: Vec<Series> = sol
+        .dof_names()
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            Series::markers(
+                name.clone(),
+                (1..=h)
+                    .map(|k| (k as f64, sol.harmonic(i, k).norm()))
+                    .collect(),
+            )
+        })
+        .collect();
+    if h > 0 {
+        line_plot(
+            &dir.join("spectrum.svg"),
+            "Amplitude spectrum (static part omitted)",
+            &Axis::linear("harmonic order"),
+            &Axis::log("amplitude"),
+            &spectra,
+        )
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    }
+    Ok(())
+}
+
+fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure> {
+    let scene = load(path, None, None)?;
+    let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
+    let h = scene.basis.harmonics();
+    let td = TimeSimulation {
+        rtol: 1e-10,
+        steady_tolerance: 1e-8,
+        samples: (4 * h + 4).next_power_of_two().max(1024),
+        ..TimeSimulation::default()
+    }
+    .run(&scene.model, scene.basis.omega())
+    .with_context(|| format!("{}: time-domain reference", scene.file))?;
+    let text = std::fs::read_to_string(path)?;
+    let mut rows = Vec::new();
+    let mut histories = Vec::new();
+    let mut any_converged = false;
+    for name in hbal::scene::METHODS {
+        let method: Method = method_named(&text, &scene.file, name)?;
+        let mut ws = hb.workspace();
+        let start = Instant::now();
+        let sol = method.solve(&hb, None, &mut ws)?;
+        let seconds = start.elapsed().as_secs_f64();
+        let n = scene.model.n_dofs();
+        let error = relative_error(sol.harmonics(), &td.harmonics, n, h);
+        any_converged |= sol.is_converged();
+        histories.push(Series::line(
+            name,
+            sol.history
+                .iter()
+                .enumerate()
+                .map(|(i, r)| (i as f64, *r))
+                .collect(),
+        ));
+        rows.push(json!({
+            "method": name,
+            "converged": sol.is_converged(),
+            "termination": sol.termination.to_string(),
+            "iterations": sol.stats.iterations,
+            "residual": sol.residual(),
+            "solve_seconds": seconds,
+            "error_vs_time_domain": error,
+        }));
+    }
+    let td_json = json!({
+        "converged": td.converged,
+        "stop": format!("{:?}", td.stop),
+        "periods": td.periods,
+        "steps": td.steps,
+        "seconds": td.wall_time.as_secs_f64(),
+    });
+    if as_json {
+        println!(
+            "{}",
+            json!({"scene": scene.file, "time_domain": td_json, "methods": rows})
+        );
+    } else {
+        println!(
+            "{}: time domain {:?} after {} periods, {} steps, {:.3} ms",
+            scene.file,
+            td.stop,
+            td.periods,
+            td.steps,
+            td.wall_time.as_secs_f64() * 1e3
+        );
+        println!("| method | result | iterations | wall | error vs time domain |");
+        println!("|---|---|---:|---:|---:|");
+        for r in &rows {
+            println!(
+                "| {} | {} | {} | {:.3} ms | {:.2e} |",
+                r["method"].as_str().unwrap_or(""),
+                r["termination"].as_str().unwrap_or(""),
+                r["iterations"],
+                r["solve_seconds"].as_f64().unwrap_or(f64::NAN) * 1e3,
+                r["error_vs_time_domain"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+    }
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir)?;
+        line_plot(
+            &dir.join("residual_histories.svg"),
+            "Residual histories",
+            &Axis::linear("iteration"),
+            &Axis::log("relative residual"),
+            &histories,
+        )
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    }
+    Ok(if any_converged { 0 } else { 1 })
+}

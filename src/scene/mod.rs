@@ -1,0 +1,500 @@
+//! Scene files: a model, its fundamental, harmonics and solver in TOML or JSON (same schema).
+//!
+//! The schema is documented in `docs/scenes.md`. [`Scene::load`] parses a file, checks every
+//! field and builds the [`Model`]; every error names the file and the field path (and, for a
+//! syntax error, the line and column).
+//!
+//! ```
+//! let text = r#"
+//! dofs = ["x"]
+//! mass = [[1.0]]
+//! damping = [[0.1]]
+//! fundamental = { rad_s = 1.2 }
+//! harmonics = { count = 7 }
+//! loads = [{ dof = "x", order = 1, cos = 0.1 }]
+//! [[elements]]
+//! name = "spring"
+//! type = "cubic_spring"
+//! connects = { x = 1.0 }
+//! k = 1.0
+//! alpha = 1.0
+//! "#;
+//! let scene = hbal::scene::Scene::from_str(text, "duffing.toml").unwrap();
+//! assert_eq!(scene.basis.harmonics(), 7);
+//! let err = hbal::scene::Scene::from_str(&text.replace("alpha", "alhpa"), "bad.toml").unwrap_err();
+//! assert!(err.to_string().contains("elements[0].alhpa"), "{err}");
+//! ```
+
+use crate::force::ForceLaw;
+use crate::solve::{Anderson, Broyden, FixedPoint, Method, Newton};
+use crate::{HarmonicBasis, Model};
+use nalgebra::DMatrix;
+use serde::Deserialize;
+use serde_json::{Map, Value};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// A scene-file error: file, where, what.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneError {
+    /// The file.
+    pub file: String,
+    /// Line and column (1-based) for syntax errors.
+    pub position: Option<(usize, usize)>,
+    /// The field path, e.g. `elements[1].profile.contact_ratio`.
+    pub path: Option<String>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl std::fmt::Display for SceneError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some((l, c)) = self.position {
+            write!(f, ":{l}:{c}")?;
+        }
+        if let Some(p) = &self.path {
+            write!(f, ": {p}")?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// The fundamental frequency: exactly one of `rpm`, `hz`, `rad_s`, times `order` (default 1;
+/// e.g. the mesh order of a shaft speed, so that a scene models only the orders it needs).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Fundamental {
+    rpm: Option<f64>,
+    hz: Option<f64>,
+    rad_s: Option<f64>,
+    #[serde(default = "one")]
+    order: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Harmonics {
+    count: usize,
+    samples: Option<usize>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LoadSpec {
+    dof: String,
+    order: usize,
+    #[serde(default)]
+    cos: f64,
+    #[serde(default)]
+    sin: f64,
+}
+
+/// Solver settings; unset fields take the method's defaults.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SolverSpec {
+    method: Option<String>,
+    gamma: Option<f64>,
+    tolerance: Option<f64>,
+    max_iterations: Option<usize>,
+    depth: Option<usize>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    #[serde(default)]
+    description: Option<String>,
+    dofs: Vec<String>,
+    mass: Vec<Vec<f64>>,
+    #[serde(default)]
+    damping: Option<Vec<Vec<f64>>>,
+    #[serde(default)]
+    stiffness: Option<Vec<Vec<f64>>>,
+    fundamental: Fundamental,
+    harmonics: Harmonics,
+    #[serde(default)]
+    loads: Vec<LoadSpec>,
+    #[serde(default)]
+    elements: Vec<Map<String, Value>>,
+    #[serde(default)]
+    solver: SolverSpec,
+}
+
+/// A loaded scene: the model, its discretisation and the chosen solver.
+#[derive(Debug)]
+pub struct Scene {
+    /// The file it came from.
+    pub file: String,
+    /// Free text from the file.
+    pub description: Option<String>,
+    /// The model.
+    pub model: Model,
+    /// Ω, H, N.
+    pub basis: HarmonicBasis,
+    /// The solver with its options.
+    pub method: Method,
+}
+
+/// Names of the solver methods.
+pub const METHODS: [&str; 4] = ["fixed_point", "newton", "broyden", "anderson"];
+
+impl Scene {
+    /// Reads and builds a scene; `.json` files are JSON, everything else TOML.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            file: file.clone(),
+            position: None,
+            path: None,
+            message: format!("cannot read the file: {e}"),
+        })?;
+        Self::from_str(&text, &file)
+    }
+
+    /// Parses scene text; the format follows the name's extension (`.json` or TOML).
+    #[allow(clippy::should_implement_trait)]
+    pub fn from_str(text: &str, file: &str) -> Result<Scene, SceneError> {
+        let err = |position, path: Option<String>, message: String| SceneError {
+            file: file.to_string(),
+            position,
+            path,
+            message,
+        };
+        let value: Value = if file.ends_with(".json") {
+            serde_json::from_str(text).map_err(|e| {
+                err(
+                    Some((e.line(), e.column())),
+                    None,
+                    strip_position(&e.to_string()),
+                )
+            })?
+        } else {
+            let v: toml::Value = toml::from_str(text).map_err(|e| {
+                let pos = e.span().map(|s| line_col(text, s.start));
+                err(pos, None, e.message().to_string())
+            })?;
+            serde_json::to_value(v).map_err(|e| err(None, None, e.to_string()))?
+        };
+        let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
+            let path = e.path().to_string();
+            let message = e.into_inner().to_string();
+            let path = field_path(path, &message);
+            err(None, (path != ".").then_some(path), message)
+        })?;
+        parsed.build(file)
+    }
+}
+
+/// For "unknown field `x`" errors, the path of the offending field itself.
+fn field_path(path: String, message: &str) -> String {
+    let Some(rest) = message.strip_prefix("unknown field `") else {
+        return path;
+    };
+    let Some(name) = rest.split('`').next() else {
+        return path;
+    };
+    if path == "." || path.is_empty() {
+        name.to_string()
+    } else {
+        format!("{path}.{name}")
+    }
+}
+
+fn strip_position(message: &str) -> String {
+    match message.rfind(" at line ") {
+        Some(i) => message[..i].to_string(),
+        None => message.to_string(),
+    }
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, col)
+}
+
+impl SceneFile {
+    fn build(self, file: &str) -> Result<Scene, SceneError> {
+        let err = |path: &str, message: String| SceneError {
+            file: file.to_string(),
+            position: None,
+            path: Some(path.to_string()),
+            message,
+        };
+        let n = self.dofs.len();
+        let matrix = |name: &str, rows: &Vec<Vec<f64>>| -> Result<DMatrix<f64>, SceneError> {
+            if rows.len() != n {
+                return Err(err(
+                    name,
+                    format!("expected {n} rows (one per DOF), got {}", rows.len()),
+                ));
+            }
+            for (i, r) in rows.iter().enumerate() {
+                if r.len() != n {
+                    return Err(err(
+                        &format!("{name}[{i}]"),
+                        format!("expected {n} columns (one per DOF), got {}", r.len()),
+                    ));
+                }
+            }
+            Ok(DMatrix::from_fn(n, n, |i, j| rows[i][j]))
+        };
+        let mut builder = Model::builder(&self.dofs.iter().map(|s| s.as_str()).collect::<Vec<_>>())
+            .mass(matrix("mass", &self.mass)?);
+        if let Some(d) = &self.damping {
+            builder = builder.damping(matrix("damping", d)?);
+        }
+        if let Some(k) = &self.stiffness {
+            builder = builder.stiffness(matrix("stiffness", k)?);
+        }
+        for (i, l) in self.loads.iter().enumerate() {
+            if !self.dofs.contains(&l.dof) {
+                return Err(err(
+                    &format!("loads[{i}].dof"),
+                    format!(
+                        "unknown DOF `{}` (the scene has: {})",
+                        l.dof,
+                        self.dofs.join(", ")
+                    ),
+                ));
+            }
+            builder = builder.load(&l.dof, l.order, l.cos, l.sin);
+        }
+        for (i, e) in self.elements.into_iter().enumerate() {
+            let at = |field: &str| format!("elements[{i}].{field}");
+            let mut e = e;
+            let name = match e.remove("name") {
+                Some(Value::String(s)) => s,
+                Some(_) => return Err(err(&at("name"), "must be a string".into())),
+                None => format!("element {i}"),
+            };
+            let connects: BTreeMap<String, f64> = match e.remove("connects") {
+                Some(v) => serde_path_to_error::deserialize(v).map_err(|x| {
+                    err(
+                        &at("connects"),
+                        format!("{} (a table DOF = weight)", x.into_inner()),
+                    )
+                })?,
+                None => {
+                    return Err(err(
+                        &format!("elements[{i}]"),
+                        "missing field `connects` (a table DOF = weight)".into(),
+                    ))
+                }
+            };
+            for dof in connects.keys() {
+                if !self.dofs.contains(dof) {
+                    return Err(err(
+                        &at("connects"),
+                        format!(
+                            "unknown DOF `{dof}` (the scene has: {})",
+                            self.dofs.join(", ")
+                        ),
+                    ));
+                }
+            }
+            if !e.contains_key("type") {
+                return Err(err(
+                    &format!("elements[{i}]"),
+                    format!("missing field `type` (one of: {})", known_types()),
+                ));
+            }
+            let law: Box<dyn ForceLaw> = serde_path_to_error::deserialize(Value::Object(e))
+                .map_err(|x| {
+                    let p = x.path().to_string();
+                    let mut message = x.into_inner().to_string();
+                    let p = field_path(p, &message);
+                    let path = if p == "." {
+                        format!("elements[{i}]")
+                    } else {
+                        at(&p)
+                    };
+                    if message.contains("unknown variant") || message.contains("unknown type") {
+                        message = format!("{message}; known element types: {}", known_types());
+                    }
+                    err(&path, message)
+                })?;
+            let weights: Vec<(&str, f64)> =
+                connects.iter().map(|(d, w)| (d.as_str(), *w)).collect();
+            builder = builder.element_boxed(&name, &weights, law);
+        }
+        let model = builder.build().map_err(|e| err("model", e.to_string()))?;
+
+        let f = &self.fundamental;
+        let given: Vec<(&str, f64)> = [("rpm", f.rpm), ("hz", f.hz), ("rad_s", f.rad_s)]
+            .into_iter()
+            .filter_map(|(k, v)| v.map(|v| (k, v)))
+            .collect();
+        let omega = match given.as_slice() {
+            [("rpm", v)] => v * std::f64::consts::TAU / 60.0,
+            [("hz", v)] => v * std::f64::consts::TAU,
+            [(_, v)] => *v,
+            _ => {
+                return Err(err(
+                    "fundamental",
+                    "give exactly one of `rpm`, `hz`, `rad_s`".into(),
+                ))
+            }
+        };
+        if !(f.order.is_finite() && f.order > 0.0) {
+            return Err(err(
+                "fundamental.order",
+                format!("must be finite and > 0, got {}", f.order),
+            ));
+        }
+        let omega = omega * f.order;
+        if !(omega.is_finite() && omega > 0.0) {
+            return Err(err(
+                "fundamental",
+                format!("must be finite and > 0, got {omega} rad/s"),
+            ));
+        }
+        let mut basis = HarmonicBasis::new(omega, self.harmonics.count)
+            .map_err(|e| err("harmonics.count", e.to_string()))?;
+        if let Some(s) = self.harmonics.samples {
+            basis = basis
+                .with_samples(s)
+                .map_err(|e| err("harmonics.samples", e.to_string()))?;
+        }
+        let method = self
+            .solver
+            .method(None)
+            .map_err(|(path, message)| err(&path, message))?;
+        Ok(Scene {
+            file: file.to_string(),
+            description: self.description,
+            model,
+            basis,
+            method,
+        })
+    }
+}
+
+impl SolverSpec {
+    /// The method, optionally overriding the name.
+    fn method(&self, name: Option<&str>) -> Result<Method, (String, String)> {
+        let name = name.or(self.method.as_deref()).unwrap_or("newton");
+        let e = |field: &str, x: crate::Error| (format!("solver.{field}"), x.to_string());
+        let method = match name {
+            "fixed_point" => {
+                let mut o = FixedPoint::new();
+                if let Some(g) = self.gamma {
+                    o = o.with_gamma(g).map_err(|x| e("gamma", x))?;
+                }
+                if let Some(t) = self.tolerance {
+                    o = o.with_tolerance(t).map_err(|x| e("tolerance", x))?;
+                }
+                if let Some(m) = self.max_iterations {
+                    o = o.with_max_iterations(m);
+                }
+                Method::FixedPoint(o)
+            }
+            "newton" => {
+                let mut o = Newton::new();
+                if let Some(t) = self.tolerance {
+                    o = o.with_tolerance(t).map_err(|x| e("tolerance", x))?;
+                }
+                if let Some(m) = self.max_iterations {
+                    o = o.with_max_iterations(m);
+                }
+                Method::Newton(o)
+            }
+            "broyden" => {
+                let mut o = Broyden::new();
+                if let Some(t) = self.tolerance {
+                    o = o.with_tolerance(t).map_err(|x| e("tolerance", x))?;
+                }
+                if let Some(m) = self.max_iterations {
+                    o = o.with_max_iterations(m);
+                }
+                Method::Broyden(o)
+            }
+            "anderson" => {
+                let mut o = Anderson::new();
+                if let Some(g) = self.gamma {
+                    o = o.with_gamma(g).map_err(|x| e("gamma", x))?;
+                }
+                if let Some(d) = self.depth {
+                    o = o.with_depth(d).map_err(|x| e("depth", x))?;
+                }
+                if let Some(t) = self.tolerance {
+                    o = o.with_tolerance(t).map_err(|x| e("tolerance", x))?;
+                }
+                if let Some(m) = self.max_iterations {
+                    o = o.with_max_iterations(m);
+                }
+                Method::Anderson(o)
+            }
+            other => {
+                return Err((
+                    "solver.method".into(),
+                    format!("unknown method `{other}` (one of: {})", METHODS.join(", ")),
+                ))
+            }
+        };
+        Ok(method)
+    }
+}
+
+/// The built-in element types (users' laws compiled in are accepted too).
+pub fn known_types() -> String {
+    "linear_spring, mesh_stiffness, backlash, cubic_spring".to_string()
+}
+
+/// Re-reads a scene's solver settings with another method name (for `--method`).
+pub fn method_named(scene_text: &str, file: &str, name: &str) -> Result<Method, SceneError> {
+    let value: Value = if file.ends_with(".json") {
+        serde_json::from_str(scene_text).unwrap_or(Value::Null)
+    } else {
+        toml::from_str::<toml::Value>(scene_text)
+            .ok()
+            .and_then(|v| serde_json::to_value(v).ok())
+            .unwrap_or(Value::Null)
+    };
+    let spec: SolverSpec = value
+        .get("solver")
+        .cloned()
+        .and_then(|v| serde_json::from_value(v).ok())
+        .unwrap_or_default();
+    let spec = SolverSpec {
+        method: None,
+        ..spec
+    };
+    // Options meaningless for the chosen method (γ for Newton) are ignored.
+    let spec = match name {
+        "newton" | "broyden" => SolverSpec {
+            gamma: None,
+            depth: None,
+            ..spec
+        },
+        "fixed_point" => SolverSpec {
+            depth: None,
+            ..spec
+        },
+        _ => spec,
+    };
+    spec.method(Some(name))
+        .map_err(|(path, message)| SceneError {
+            file: file.to_string(),
+            position: None,
+            path: Some(if name_is_known(name) {
+                path
+            } else {
+                "--method".into()
+            }),
+            message,
+        })
+}
+
+fn name_is_known(name: &str) -> bool {
+    METHODS.contains(&name)
+}
