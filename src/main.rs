@@ -292,29 +292,45 @@ fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure
     let scene = load(path, None, None)?;
     let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
     let h = scene.basis.harmonics();
-    let td = TimeSimulation {
-        rtol: 1e-10,
-        steady_tolerance: 1e-8,
-        samples: (4 * h + 4).next_power_of_two().max(1024),
-        ..TimeSimulation::default()
-    }
-    .run(&scene.model, scene.basis.omega())
-    .with_context(|| format!("{}: time-domain reference", scene.file))?;
+    let n = scene.model.n_dofs();
     let text = std::fs::read_to_string(path)?;
-    let mut rows = Vec::new();
-    let mut histories = Vec::new();
-    let mut any_converged = false;
+    let mut solutions = Vec::new();
     for name in hbal::scene::METHODS {
         let method: Method = method_named(&text, &scene.file, name)?;
         let mut ws = hb.workspace();
         let start = Instant::now();
         let sol = method.solve(&hb, None, &mut ws)?;
-        let seconds = start.elapsed().as_secs_f64();
-        let n = scene.model.n_dofs();
+        solutions.push((name, start.elapsed().as_secs_f64(), sol));
+    }
+    // The time-domain reference starts on the first converged HB orbit (from rest if none):
+    // a gear pair with backlash can have coexisting orbits, and a run from rest may find
+    // another one. Its error then measures the HB orbit, and grows if that orbit is unstable.
+    let start_state = solutions
+        .iter()
+        .find(|s| s.2.is_converged())
+        .map(|(_, _, sol)| {
+            let q = (0..n).map(|i| sol.displacement(i, 0.0)).collect::<Vec<_>>();
+            let v = (0..n).map(|i| sol.velocity(i, 0.0)).collect::<Vec<_>>();
+            (q, v)
+        });
+    let from_orbit = start_state.is_some();
+    let td = TimeSimulation {
+        rtol: 1e-10,
+        steady_tolerance: 1e-8,
+        samples: (4 * h + 4).next_power_of_two().max(1024),
+        initial: start_state,
+        ..TimeSimulation::default()
+    }
+    .run(&scene.model, scene.basis.omega())
+    .with_context(|| format!("{}: time-domain reference", scene.file))?;
+    let mut rows = Vec::new();
+    let mut histories = Vec::new();
+    let mut any_converged = false;
+    for (name, seconds, sol) in &solutions {
         let error = relative_error(sol.harmonics(), &td.harmonics, n, h);
         any_converged |= sol.is_converged();
         histories.push(Series::line(
-            name,
+            *name,
             sol.history
                 .iter()
                 .enumerate()
@@ -332,6 +348,7 @@ fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure
         }));
     }
     let td_json = json!({
+        "started_on_hb_orbit": from_orbit,
         "converged": td.converged,
         "stop": format!("{:?}", td.stop),
         "periods": td.periods,
@@ -345,8 +362,9 @@ fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure
         );
     } else {
         println!(
-            "{}: time domain {:?} after {} periods, {} steps, {:.3} ms",
+            "{}: time domain (from {}) {:?} after {} periods, {} steps, {:.3} ms",
             scene.file,
+            if from_orbit { "the HB orbit" } else { "rest" },
             td.stop,
             td.periods,
             td.steps,

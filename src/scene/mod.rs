@@ -179,7 +179,7 @@ impl Scene {
         } else {
             let v: toml::Value = toml::from_str(text).map_err(|e| {
                 let pos = e.span().map(|s| line_col(text, s.start));
-                err(pos, None, e.message().to_string())
+                err(pos, None, e.message().trim().replace('\n', "; "))
             })?;
             serde_json::to_value(v).map_err(|e| err(None, None, e.to_string()))?
         };

@@ -1,0 +1,249 @@
+//! The `hbal` binary on every example scene and on a catalogue of broken scenes, each with the
+//! message it must show and exit code 2.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn hbal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args(args)
+        .output()
+        .expect("run hbal")
+}
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes")
+}
+
+#[test]
+fn every_example_scene_solves_and_checks() {
+    let mut count = 0;
+    for entry in std::fs::read_dir(scenes_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        let p = path.to_str().unwrap();
+        let out = hbal(&["check", p]);
+        assert!(
+            out.status.success(),
+            "check {p}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let out = hbal(&["solve", p, "--json"]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "solve {p}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+        assert_eq!(doc["converged"], true, "{p}");
+        for key in [
+            "termination",
+            "method",
+            "iterations",
+            "residual",
+            "fundamental_rad_s",
+            "harmonics",
+            "samples",
+            "solve_seconds",
+            "dofs",
+            "history",
+        ] {
+            assert!(doc.get(key).is_some(), "{p}: missing {key}");
+        }
+        let dof = &doc["dofs"][0];
+        assert!(dof["name"].is_string() && dof["max_abs"].as_f64().unwrap() > 0.0);
+        assert_eq!(dof["harmonics"][0]["order"], 0);
+        assert!(doc["solve_seconds"].as_f64().unwrap() < 1.0);
+        count += 1;
+    }
+    assert!(count >= 7, "{count} scenes");
+}
+
+#[test]
+fn solve_json_matches_the_library_and_writes_outputs() {
+    let scene = scenes_dir().join("two_shaft_6000rpm.toml");
+    let dir = std::env::temp_dir().join(format!("hbal-cli-{}", std::process::id()));
+    let out = hbal(&[
+        "solve",
+        scene.to_str().unwrap(),
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // q(t) = Σ cos_k cos(kΩt) + sin_k sin(kΩt): the static part is L0 / K_mean, shifted by the
+    // mesh variation (reference: 2.98961e-5).
+    let a0 = doc["dofs"][0]["harmonics"][0]["cos"].as_f64().unwrap();
+    assert!((a0 - 2.98961e-5).abs() < 2e-9, "{a0}");
+    let omega = doc["fundamental_rad_s"].as_f64().unwrap();
+    assert!((omega - 4.0 * 6000.0 * std::f64::consts::TAU / 60.0).abs() < 1e-9);
+    for f in [
+        "harmonics.csv",
+        "time_series.csv",
+        "time_series.svg",
+        "spectrum.svg",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    let csv = std::fs::read_to_string(dir.join("harmonics.csv")).unwrap();
+    assert!(csv.starts_with("dof,order,cos,sin\ngear,0,"));
+    // Overrides.
+    let out = hbal(&[
+        "solve",
+        scene.to_str().unwrap(),
+        "--json",
+        "--method",
+        "anderson",
+        "--harmonics",
+        "16",
+    ]);
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["method"], "anderson");
+    assert_eq!(doc["harmonics"], 16);
+}
+
+#[test]
+fn non_converged_solve_exits_1_with_its_result() {
+    let scene = scenes_dir().join("gear_backlash.toml");
+    let out = hbal(&[
+        "solve",
+        scene.to_str().unwrap(),
+        "--json",
+        "--method",
+        "fixed_point",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["converged"], false);
+    assert_eq!(doc["termination"], "maximum iterations reached");
+}
+
+#[test]
+fn compare_reports_every_method() {
+    let scene = scenes_dir().join("duffing.toml");
+    let out = hbal(&["compare", scene.to_str().unwrap(), "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let methods = doc["methods"].as_array().unwrap();
+    assert_eq!(methods.len(), 4);
+    for m in methods {
+        assert_eq!(m["converged"], true, "{m}");
+        assert!(m["error_vs_time_domain"].as_f64().unwrap() < 1e-6, "{m}");
+    }
+}
+
+const GOOD: &str = r#"
+dofs = ["x"]
+mass = [[1.0]]
+damping = [[0.1]]
+fundamental = { rad_s = 1.3 }
+harmonics = { count = 3 }
+loads = [{ dof = "x", order = 1, cos = 0.1 }]
+
+[[elements]]
+name = "spring"
+type = "linear_spring"
+connects = { x = 1.0 }
+k = 1.0
+"#;
+
+fn broken(name: &str, text: &str, expected: &str) {
+    let dir = std::env::temp_dir().join(format!("hbal-broken-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    let out = hbal(&["check", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+    assert!(err.contains(expected), "{name}: `{err}` lacks `{expected}`");
+    assert!(
+        err.contains(name),
+        "{name}: the message must name the file: {err}"
+    );
+    assert!(!err.contains("panicked"), "{name}: {err}");
+}
+
+#[test]
+fn good_scene_passes_the_catalogue_baseline() {
+    let dir = std::env::temp_dir();
+    let path = dir.join(format!("hbal-good-{}.toml", std::process::id()));
+    std::fs::write(&path, GOOD).unwrap();
+    assert!(hbal(&["check", path.to_str().unwrap()]).status.success());
+}
+
+#[test]
+fn broken_scenes_give_messages_that_name_file_and_field() {
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("syntax.toml", GOOD.replace("dofs = [\"x\"]", "dofs = [\"x\""), "syntax.toml:3:1: invalid array; expected `]`"),
+        ("syntax.json", "{\n \"dofs\": [\"x\"],\n \"mass\": [[1.0]\n}".into(), "syntax.json:4:"),
+        ("misspelled.toml", GOOD.replace("mass =", "mas ="), "unknown field `mas`"),
+        ("missing_mass.toml", GOOD.replace("mass = [[1.0]]", ""), "missing field `mass`"),
+        ("unknown_type.toml", GOOD.replace("linear_spring", "linear_sprung"), "known element types: linear_spring"),
+        ("law_field.toml", GOOD.replace("k = 1.0", "kk = 1.0"), "elements[0].kk: unknown field `kk`"),
+        ("connects_dof.toml", GOOD.replace("connects = { x = 1.0 }", "connects = { y = 1.0 }"), "elements[0].connects: unknown DOF `y`"),
+        ("load_dof.toml", GOOD.replace("dof = \"x\"", "dof = \"z\""), "loads[0].dof: unknown DOF `z`"),
+        ("mass_rows.toml", GOOD.replace("mass = [[1.0]]", "mass = [[1.0], [2.0]]"), "mass: expected 1 rows"),
+        ("mass_cols.toml", GOOD.replace("mass = [[1.0]]", "mass = [[1.0, 0.0]]"), "mass[0]: expected 1 columns"),
+        ("mass_negative.toml", GOOD.replace("mass = [[1.0]]", "mass = [[-1.0]]"), "not symmetric positive definite"),
+        ("mass_type.toml", GOOD.replace("mass = [[1.0]]", "mass = \"heavy\""), "mass: invalid type"),
+        ("negative_k.toml", GOOD.replace("k = 1.0", "k = -1.0"), "parameter `k` must be finite and >= 0"),
+        (
+            "negative_backlash.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"backlash\"")
+                .replace("k = 1.0", "half_backlash = -0.5\nstiffness = { shape = \"constant\", stiffness = 1.0 }"),
+            "half_backlash",
+        ),
+        (
+            "contact_ratio.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"mesh_stiffness\"").replace(
+                "k = 1.0",
+                "teeth = 1\nprofile = { shape = \"rectangular\", one_tooth = 1.0, two_tooth = 2.0, contact_ratio = 2.5 }",
+            ),
+            "contact_ratio` must be in [1, 2]",
+        ),
+        (
+            "teeth.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"mesh_stiffness\"")
+                .replace("k = 1.0", "teeth = 0\nprofile = { shape = \"constant\", stiffness = 1.0 }"),
+            "teeth",
+        ),
+        (
+            "shape.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"mesh_stiffness\"")
+                .replace("k = 1.0", "teeth = 1\nprofile = { shape = \"triangle\", mean = 1.0 }"),
+            "unknown variant `triangle`",
+        ),
+        ("two_units.toml", GOOD.replace("{ rad_s = 1.3 }", "{ rad_s = 1.3, rpm = 60 }"), "fundamental: give exactly one of"),
+        ("negative_speed.toml", GOOD.replace("{ rad_s = 1.3 }", "{ rpm = -600 }"), "fundamental: must be finite and > 0"),
+        ("samples.toml", GOOD.replace("{ count = 3 }", "{ count = 3, samples = 4 }"), "harmonics.samples"),
+        ("load_order.toml", GOOD.replace("order = 1", "order = 5"), "order 5 but only 3 harmonics"),
+        ("method.toml", format!("{GOOD}\n[solver]\nmethod = \"newtn\"\n"), "solver.method: unknown method `newtn`"),
+        ("gamma.toml", format!("{GOOD}\n[solver]\nmethod = \"fixed_point\"\ngamma = 1.5\n"), "solver.gamma"),
+        ("no_connects.toml", GOOD.replace("connects = { x = 1.0 }", ""), "elements[0]: missing field `connects`"),
+        ("no_type.toml", GOOD.replace("type = \"linear_spring\"", ""), "elements[0]: missing field `type`"),
+        (
+            "resonance.toml",
+            GOOD.replace("damping = [[0.1]]", "").replace("{ rad_s = 1.3 }", "{ rad_s = 0.5 }"),
+            "singular at harmonic 2",
+        ),
+    ];
+    assert!(cases.len() >= 20);
+    for (name, text, expected) in &cases {
+        broken(name, text, expected);
+    }
+    // A missing file and a bad command-line method.
+    let out = hbal(&["check", "no/such/scene.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("no/such/scene.toml: cannot read the file")
+    );
+    let scene = scenes_dir().join("duffing.toml");
+    let out = hbal(&["solve", scene.to_str().unwrap(), "--method", "bogus"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown method `bogus`"));
+}
