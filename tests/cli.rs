@@ -247,3 +247,30 @@ fn broken_scenes_give_messages_that_name_file_and_field() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown method `bogus`"));
 }
+
+/// Every TOML and JSON example in docs/scenes.md is a complete scene that checks and solves.
+#[test]
+fn documented_examples_are_valid_scenes() {
+    let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scenes.md"))
+        .unwrap();
+    let dir = std::env::temp_dir().join(format!("hbal-doc-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut count = 0;
+    for (lang, ext) in [("```toml", "toml"), ("```json", "json")] {
+        for (i, block) in doc.split(lang).skip(1).enumerate() {
+            let body = block.split("```").next().unwrap();
+            let path = dir.join(format!("doc{i}.{ext}"));
+            std::fs::write(&path, body).unwrap();
+            let out = hbal(&["solve", path.to_str().unwrap(), "--json"]);
+            assert_eq!(
+                out.status.code(),
+                Some(0),
+                "docs example {ext} #{i}: {}{}",
+                String::from_utf8_lossy(&out.stderr),
+                body
+            );
+            count += 1;
+        }
+    }
+    assert!(count >= 6, "{count} examples");
+}
