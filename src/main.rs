@@ -79,6 +79,10 @@ impl<E: Into<anyhow::Error>> From<E> for Failure {
 }
 
 fn main() -> ExitCode {
+    // A bug must not greet a user with a backtrace: one line, and where to report it.
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!("error: internal error in hbal ({info}); please report it with the scene file");
+    }));
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Solve {

@@ -223,6 +223,7 @@ fn broken_scenes_give_messages_that_name_file_and_field() {
         ("samples.toml", GOOD.replace("{ count = 3 }", "{ count = 3, samples = 4 }"), "harmonics.samples"),
         ("load_order.toml", GOOD.replace("order = 1", "order = 5"), "order 5 but only 3 harmonics"),
         ("method.toml", format!("{GOOD}\n[solver]\nmethod = \"newtn\"\n"), "solver.method: unknown method `newtn`"),
+        ("solver_field.toml", format!("{GOOD}\n[solver]\ntolerence = 1e-8\n"), "solver.tolerence: unknown field `tolerence`, expected one of"),
         ("gamma.toml", format!("{GOOD}\n[solver]\nmethod = \"fixed_point\"\ngamma = 1.5\n"), "solver.gamma"),
         ("no_connects.toml", GOOD.replace("connects = { x = 1.0 }", ""), "elements[0]: missing field `connects`"),
         ("no_type.toml", GOOD.replace("type = \"linear_spring\"", ""), "elements[0]: missing field `type`"),

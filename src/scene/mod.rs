@@ -203,6 +203,8 @@ fn field_path(path: String, message: &str) -> String {
     };
     if path == "." || path.is_empty() {
         name.to_string()
+    } else if path == name || path.ends_with(&format!(".{name}")) {
+        path
     } else {
         format!("{path}.{name}")
     }
