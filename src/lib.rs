@@ -64,6 +64,7 @@ pub mod residual;
 pub mod scene;
 pub mod solution;
 pub mod solve;
+pub mod stability;
 pub mod timesim;
 
 pub use error::{Error, Result};

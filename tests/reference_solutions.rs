@@ -153,3 +153,48 @@ fn time_domain_reports_a_stall() {
     assert_eq!(td.stop, hbal::timesim::TimeStop::Stalled);
     assert!(td.periods < 2000, "{}", td.periods);
 }
+
+/// Floquet multipliers from the HB solution's monodromy matrix against the shared references.
+#[test]
+fn floquet_multipliers_match_references() {
+    use hbal::stability::floquet;
+    use hbal::Newton;
+    let cases: Vec<(&str, hbal::Model, usize)> = vec![
+        (
+            "seed_rect_6000rpm.json",
+            TwoShaft::new(6000.0).model().unwrap(),
+            128,
+        ),
+        (
+            "kahraman_A_W0.50_unique.json",
+            GearBacklash::default().model().unwrap(),
+            32,
+        ),
+        (
+            "duffing_W1.00_unique.json",
+            Duffing::default().model().unwrap(),
+            15,
+        ),
+    ];
+    for (file, model, h) in cases {
+        let r = reference(file);
+        let hb = HarmonicBalance::new(&model, HarmonicBasis::new(r.omega, h).unwrap()).unwrap();
+        let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
+        assert!(sol.is_converged(), "{file}");
+        let f = floquet(&model, &sol, 2048).unwrap();
+        let expected: Vec<f64> = r.json["floquet_multipliers_abs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        for (got, want) in f.multipliers.iter().zip(&expected) {
+            assert!(
+                (got.norm() - want).abs() < 2e-3 * want.max(0.1),
+                "{file}: |μ| {} vs {want}",
+                got.norm()
+            );
+        }
+        assert!(f.is_stable(), "{file}");
+    }
+}
