@@ -54,6 +54,7 @@
 
 pub mod catalog;
 pub mod compare;
+pub mod continuation;
 pub mod error;
 pub mod force;
 pub mod harmonic;

@@ -31,6 +31,8 @@ pub struct HarmonicBalance<'m> {
     f_ext: Vec<Complex64>,
     /// `F_ext - Σ w f0`: the load seen by the split (offsets of the linear parts moved over).
     f_split: Vec<Complex64>,
+    d0: DMatrix<f64>,
+    k0: DMatrix<f64>,
     active: Vec<ActiveElement>,
     thetas: Vec<f64>,
 }
@@ -110,7 +112,8 @@ impl<'m> HarmonicBalance<'m> {
                 &mut f_split[..n],
             );
         }
-        let z = DynamicStiffness::new(&basis, model.mass(), &model.d0(), &model.k0())?;
+        let (d0, k0) = (model.d0(), model.k0());
+        let z = DynamicStiffness::new(&basis, model.mass(), &d0, &k0)?;
         let samples = basis.samples();
         let thetas: Vec<f64> = (0..samples).map(|j| basis.theta(j)).collect();
         let active = model
@@ -144,6 +147,8 @@ impl<'m> HarmonicBalance<'m> {
             z,
             f_ext,
             f_split,
+            d0,
+            k0,
             active,
             thetas,
         })
@@ -316,6 +321,77 @@ impl<'m> HarmonicBalance<'m> {
                 );
             }
         }
+        Ok(())
+    }
+
+    /// `out ← ∂R/∂Ω` at `x` (real layout), analytic: `(dZ_k/dΩ) Q_k` with
+    /// `dZ_k/dΩ = -2k²Ω M + i k D0`, plus the AFT of `(∂f/∂u̇ - d0) u̇/Ω` per element (the rest
+    /// depends on Ω only through `u̇ = Σ i kΩ U_k e^{ikθ}`). For continuation in Ω.
+    pub fn omega_derivative_real_into(
+        &self,
+        x: &[f64],
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<()> {
+        let layout = self.layout();
+        let (n, h) = (layout.n, layout.h);
+        let omega = self.basis.omega();
+        layout.unpack(x, &mut ws.q);
+        let m = self.model.mass();
+        for k in 0..=h {
+            let kf = k as f64;
+            for i in 0..n {
+                let mut acc = Complex64::default();
+                for j in 0..n {
+                    let dz =
+                        Complex64::new(-2.0 * kf * kf * omega * m[(i, j)], kf * self.d0[(i, j)]);
+                    acc += dz * ws.q[k * n + j];
+                }
+                ws.rhs[k * n + i] = acc;
+            }
+        }
+        let b = &mut ws.eval;
+        for act in &self.active {
+            let e = &self.model.elements()[act.index];
+            for k in 0..=h {
+                b.uk[k] = e.gather(&ws.q[k * n..(k + 1) * n]);
+            }
+            self.aft
+                .synthesize_into(&b.uk, |_| Complex64::new(1.0, 0.0), &mut b.u, &mut b.aft);
+            self.aft.synthesize_into(
+                &b.uk,
+                |k| Complex64::new(0.0, k as f64 * omega),
+                &mut b.du,
+                &mut b.aft,
+            );
+            let law = e.law();
+            law.derivatives_batch(&self.thetas, &b.u, &b.du, &mut b.gu, &mut b.gdu);
+            let d0 = e.linear_part().damping;
+            for ((f, g), du) in b.f.iter_mut().zip(&b.gdu).zip(&b.du) {
+                *f = (g - d0) * du / omega;
+            }
+            if !b.f.iter().all(|v| v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: format!("Ω-derivative of element `{}`", e.name()),
+                });
+            }
+            self.aft.analyze_into(&mut b.f, &mut b.uk, &mut b.aft);
+            b.ffts += 3;
+            for k in 0..=h {
+                e.scatter_add(b.uk[k], &mut ws.rhs[k * n..(k + 1) * n]);
+            }
+        }
+        layout.pack(&ws.rhs, out);
+        Ok(())
+    }
+
+    /// Moves the discretisation to a new fundamental Ω (rebuilds and factors `Z_k`); for
+    /// sweeps. Errors as [`HarmonicBalance::new`] on a singular `Z_k`.
+    pub fn set_omega(&mut self, omega: f64) -> Result<()> {
+        let basis = HarmonicBasis::new(omega, self.basis.harmonics())?
+            .with_samples(self.basis.samples())?;
+        self.z = DynamicStiffness::new(&basis, self.model.mass(), &self.d0, &self.k0)?;
+        self.basis = basis;
         Ok(())
     }
 

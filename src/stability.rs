@@ -49,15 +49,19 @@ impl Floquet {
         self.max_abs() < 1.0 - 1e-6
     }
 
-    /// The kind of the critical multiplier (the one of largest modulus).
+    /// The kind of the critical multiplier (the one of largest modulus), by where it sits on
+    /// the unit circle: argument within 0.1 rad of 0 (fold), of π (period doubling), else
+    /// Neimark–Sacker. (A real pair near +1 can come out of the eigensolver as a complex pair
+    /// with a tiny argument, hence the margin.)
     pub fn critical(&self) -> Option<Bifurcation> {
         let m = *self.multipliers.first()?;
-        Some(if m.im.abs() > 1e-6 * m.norm().max(1.0) {
-            Bifurcation::NeimarkSacker
-        } else if m.re > 0.0 {
+        let angle = m.arg().abs();
+        Some(if angle < 0.1 {
             Bifurcation::Fold
-        } else {
+        } else if angle > std::f64::consts::PI - 0.1 {
             Bifurcation::PeriodDoubling
+        } else {
+            Bifurcation::NeimarkSacker
         })
     }
 }
@@ -80,14 +84,36 @@ pub fn floquet(model: &Model, solution: &Solution, steps: usize) -> Result<Floqu
             reason: "Cholesky factorisation failed".into(),
         })?;
     let m_inv = chol.inverse();
-    // A(t) at 2·steps + 1 equidistant times (ends and midpoints).
-    let a_at = |j: usize| -> DMatrix<f64> {
-        let t = j as f64 * 0.5 * dt;
-        let theta = omega * t;
-        let q: Vec<f64> = (0..n).map(|i| solution.displacement(i, theta)).collect();
-        let v: Vec<f64> = (0..n).map(|i| solution.velocity(i, theta)).collect();
-        let mut k = model.structural_stiffness().clone();
-        let mut d = model.structural_damping().clone();
+    // A(t) at 2·steps + 1 equidistant times (ends and midpoints), written into `a`.
+    let h = solution.basis().harmonics();
+    let harmonics = solution.harmonics();
+    let (ks, ds) = (model.structural_stiffness(), model.structural_damping());
+    let mut q = vec![0.0; n];
+    let mut v = vec![0.0; n];
+    let mut k = DMatrix::zeros(n, n);
+    let mut d = DMatrix::zeros(n, n);
+    let mut mk = DMatrix::zeros(n, n);
+    let mut md = DMatrix::zeros(n, n);
+    let mut a_at = |j: usize, a: &mut DMatrix<f64>| {
+        let theta = omega * j as f64 * 0.5 * dt;
+        // q, q̇ by the recurrence e^{ikθ} = e^{iθ} e^{i(k-1)θ}: one sin/cos per time.
+        let step = Complex64::from_polar(1.0, theta);
+        let mut rot = Complex64::new(1.0, 0.0);
+        for i in 0..n {
+            q[i] = harmonics[i].re;
+            v[i] = 0.0;
+        }
+        for kk in 1..=h {
+            rot *= step;
+            let kw = kk as f64 * omega;
+            for i in 0..n {
+                let z = harmonics[kk * n + i] * rot;
+                q[i] += z.re;
+                v[i] -= kw * z.im;
+            }
+        }
+        k.copy_from(ks);
+        d.copy_from(ds);
         for e in model.elements() {
             let (dk, dd) = e.law().derivatives(theta, e.gather(&q), e.gather(&v));
             for &(i, wi) in e.weights() {
@@ -97,29 +123,50 @@ pub fn floquet(model: &Model, solution: &Solution, steps: usize) -> Result<Floqu
                 }
             }
         }
-        let mk = -(&m_inv * k);
-        let md = -(&m_inv * d);
-        let mut a = DMatrix::zeros(2 * n, 2 * n);
+        m_inv.mul_to(&k, &mut mk);
+        m_inv.mul_to(&d, &mut md);
+        a.fill(0.0);
         for i in 0..n {
             a[(i, n + i)] = 1.0;
             for jj in 0..n {
-                a[(n + i, jj)] = mk[(i, jj)];
-                a[(n + i, n + jj)] = md[(i, jj)];
+                a[(n + i, jj)] = -mk[(i, jj)];
+                a[(n + i, n + jj)] = -md[(i, jj)];
             }
         }
-        a
     };
-    let mut phi = DMatrix::<f64>::identity(2 * n, 2 * n);
-    let mut a0 = a_at(0);
-    for s in 0..steps {
-        let am = a_at(2 * s + 1);
-        let a1 = a_at(2 * s + 2);
-        let k1 = &a0 * &phi;
-        let k2 = &am * (&phi + &k1 * (0.5 * dt));
-        let k3 = &am * (&phi + &k2 * (0.5 * dt));
-        let k4 = &a1 * (&phi + &k3 * dt);
-        phi += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (dt / 6.0);
-        a0 = a1;
+    let s2 = 2 * n;
+    let mut phi = DMatrix::<f64>::identity(s2, s2);
+    let (mut a0, mut am, mut a1) = (
+        DMatrix::zeros(s2, s2),
+        DMatrix::zeros(s2, s2),
+        DMatrix::zeros(s2, s2),
+    );
+    let (mut k1, mut k2, mut k3, mut k4) = (
+        DMatrix::zeros(s2, s2),
+        DMatrix::zeros(s2, s2),
+        DMatrix::zeros(s2, s2),
+        DMatrix::zeros(s2, s2),
+    );
+    let mut tmp = DMatrix::zeros(s2, s2);
+    a_at(0, &mut a0);
+    for st in 0..steps {
+        a_at(2 * st + 1, &mut am);
+        a_at(2 * st + 2, &mut a1);
+        a0.mul_to(&phi, &mut k1);
+        tmp.copy_from(&phi);
+        axpy(&mut tmp, 0.5 * dt, &k1);
+        am.mul_to(&tmp, &mut k2);
+        tmp.copy_from(&phi);
+        axpy(&mut tmp, 0.5 * dt, &k2);
+        am.mul_to(&tmp, &mut k3);
+        tmp.copy_from(&phi);
+        axpy(&mut tmp, dt, &k3);
+        a1.mul_to(&tmp, &mut k4);
+        axpy(&mut phi, dt / 6.0, &k1);
+        axpy(&mut phi, dt / 3.0, &k2);
+        axpy(&mut phi, dt / 3.0, &k3);
+        axpy(&mut phi, dt / 6.0, &k4);
+        std::mem::swap(&mut a0, &mut a1);
     }
     if !phi.iter().all(|v| v.is_finite()) {
         return Err(Error::NonFinite {
@@ -129,4 +176,11 @@ pub fn floquet(model: &Model, solution: &Solution, steps: usize) -> Result<Floqu
     let mut multipliers: Vec<Complex64> = phi.complex_eigenvalues().iter().copied().collect();
     multipliers.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
     Ok(Floquet { multipliers })
+}
+
+/// `y += a x` for matrices of one shape.
+fn axpy(y: &mut DMatrix<f64>, a: f64, x: &DMatrix<f64>) {
+    for (yi, xi) in y.iter_mut().zip(x.iter()) {
+        *yi += a * xi;
+    }
 }

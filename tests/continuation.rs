@@ -1,0 +1,150 @@
+//! Continuation through folds and stability, against the analytic one-harmonic Duffing
+//! response and long time integration.
+
+use hbal::catalog::Duffing;
+use hbal::compare::relative_error;
+use hbal::continuation::{BranchStop, Continuation};
+use hbal::stability::Bifurcation;
+use hbal::timesim::TimeSimulation;
+use hbal::HarmonicBasis;
+
+/// With H = 1 (and N >= 5, exact for a cubic) harmonic balance *is* the classic one-harmonic
+/// balance: every point satisfies `[(k - mΩ² + ¾αA²)² + (cΩ)²] A² = F²` exactly, through both
+/// folds of the S-curve.
+#[test]
+fn duffing_one_harmonic_branch_is_the_analytic_curve() {
+    let d = Duffing {
+        c: 0.01,
+        force: 0.01,
+        ..Duffing::default()
+    };
+    let model = d.model().unwrap();
+    let branch = Continuation::default()
+        .run(&model, HarmonicBasis::new(0.6, 1).unwrap(), 2.0, |_| {})
+        .unwrap();
+    assert_eq!(branch.stop, BranchStop::Reached);
+    assert_eq!(branch.folds(), 2, "an S-shaped curve has two folds");
+    for p in &branch.points {
+        let a = p.harmonics[1].norm();
+        let w = p.omega;
+        let lhs =
+            ((d.k - d.m * w * w + 0.75 * d.alpha * a * a).powi(2) + (d.c * w).powi(2)) * a * a;
+        let f2 = d.force * d.force;
+        assert!((lhs - f2).abs() < 1e-8 * f2, "Ω {w}: {lhs} vs {f2}");
+    }
+    // The upper fold sits near the backbone Ω² = 1 + ¾A² at the peak amplitude A ≈ F/(cΩ).
+    let upper = branch
+        .points
+        .iter()
+        .filter(|p| p.fold)
+        .map(|p| p.omega)
+        .fold(0.0, f64::max);
+    let a_peak = branch
+        .points
+        .iter()
+        .map(|p| p.harmonics[1].norm())
+        .fold(0.0, f64::max);
+    let backbone = (1.0 + 0.75 * a_peak * a_peak).sqrt();
+    assert!(
+        (upper - backbone).abs() < 2e-3,
+        "fold {upper} vs backbone {backbone}"
+    );
+    // Stable outer branches, unstable middle branch: stability changes exactly at the folds.
+    let changes: Vec<_> = branch.points.iter().filter_map(|p| p.bifurcation).collect();
+    assert_eq!(changes, vec![Bifurcation::Fold, Bifurcation::Fold]);
+}
+
+/// The fold locations converge as H grows (Duffing, F = 0.1, through both folds).
+#[test]
+fn fold_locations_converge_with_harmonics() {
+    let model = Duffing::default().model().unwrap();
+    let mut upper = Vec::new();
+    for h in [1usize, 3, 5, 7, 9] {
+        let branch = Continuation {
+            floquet_steps: Some(0),
+            ..Continuation::default()
+        }
+        .run(&model, HarmonicBasis::new(0.5, h).unwrap(), 3.0, |_| {})
+        .unwrap();
+        assert_eq!(branch.folds(), 2, "H {h}");
+        upper.push(
+            branch
+                .points
+                .iter()
+                .filter(|p| p.fold)
+                .map(|p| p.omega)
+                .fold(0.0, f64::max),
+        );
+    }
+    // H = 1 misses the third harmonic (fold 7e-3 too low); from H = 3 on the fold sits at
+    // 2.21154 to the resolution of the branch points (the fold is the turning point between two
+    // computed points, not interpolated).
+    let last = upper[upper.len() - 1];
+    assert!((upper[0] - last).abs() > 5e-3, "{upper:?}");
+    for u in &upper[1..] {
+        assert!((u - last).abs() < 2e-5, "{upper:?}");
+    }
+}
+
+/// Stability flags against long time integration started near each solution: at Ω = 1.5 the
+/// Duffing oscillator has three periodic solutions; the two stable ones persist, the middle
+/// one is left for another orbit.
+#[test]
+fn stability_flags_agree_with_time_integration() {
+    let model = Duffing::default().model().unwrap();
+    let branch = Continuation::default()
+        .run(&model, HarmonicBasis::new(0.5, 7).unwrap(), 3.0, |_| {})
+        .unwrap();
+    let target = 1.5;
+    // The three crossings of Ω = 1.5.
+    let mut found = Vec::new();
+    for w in branch.points.windows(2) {
+        if (w[0].omega - target) * (w[1].omega - target) <= 0.0 {
+            found.push(
+                if (w[0].omega - target).abs() < (w[1].omega - target).abs() {
+                    &w[0]
+                } else {
+                    &w[1]
+                },
+            );
+        }
+    }
+    assert_eq!(found.len(), 3, "three coexisting solutions near Ω = 1.5");
+    let stable: Vec<bool> = found.iter().map(|p| p.stable().unwrap()).collect();
+    assert_eq!(stable, vec![true, false, true]);
+    for p in found {
+        let hb_model = &model;
+        let theta0 = 0.0;
+        let sol_q: f64 = (0..=7)
+            .map(|k| {
+                (p.harmonics[k] * num_complex::Complex64::from_polar(1.0, k as f64 * theta0)).re
+            })
+            .sum();
+        let sol_v: f64 = (1..=7)
+            .map(|k| (p.harmonics[k] * num_complex::Complex64::new(0.0, k as f64 * p.omega)).re)
+            .sum();
+        let td = TimeSimulation {
+            rtol: 1e-10,
+            steady_tolerance: 1e-9,
+            samples: 64,
+            initial: Some((vec![sol_q * 1.001], vec![sol_v])),
+            ..TimeSimulation::default()
+        }
+        .run(hb_model, p.omega)
+        .unwrap();
+        let distance = relative_error(&td.harmonics, &p.harmonics, 1, 7);
+        if p.stable().unwrap() {
+            assert!(
+                distance < 1e-4,
+                "stable point at Ω {} drifted by {distance}",
+                p.omega
+            );
+        } else {
+            assert!(
+                distance > 1e-2,
+                "unstable point at Ω {} persisted ({distance})",
+                p.omega
+            );
+        }
+    }
+}
