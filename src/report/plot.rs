@@ -11,6 +11,10 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Draw markers instead of a line.
     pub markers: bool,
+    /// Draw the line dashed.
+    pub dashed: bool,
+    /// Palette index (default: the series' position).
+    pub color: Option<usize>,
 }
 
 impl Series {
@@ -20,16 +24,31 @@ impl Series {
             label: label.into(),
             points,
             markers: false,
+            dashed: false,
+            color: None,
         }
     }
 
     /// Markers only.
     pub fn markers(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
         Self {
-            label: label.into(),
-            points,
             markers: true,
+            ..Self::line(label, points)
         }
+    }
+
+    /// A dashed line.
+    pub fn dashed(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            dashed: true,
+            ..Self::line(label, points)
+        }
+    }
+
+    /// Sets the palette index (an empty label keeps the series out of the legend).
+    pub fn with_color(mut self, color: usize) -> Self {
+        self.color = Some(color);
+        self
     }
 }
 
@@ -130,19 +149,35 @@ pub fn line_plot(
                 .y_desc(y.label.as_str())
                 .draw()?;
             for (i, (s, p)) in series.iter().zip(&pts).enumerate() {
-                let color = COLORS[i % COLORS.len()];
+                let color = COLORS[s.color.unwrap_or(i) % COLORS.len()];
+                let labelled = !s.label.is_empty();
                 if s.markers {
-                    chart
-                        .draw_series(p.iter().map(|&c| Circle::new(c, 3, color.filled())))?
-                        .label(s.label.as_str())
-                        .legend(move |(lx, ly)| Circle::new((lx + 10, ly), 3, color.filled()));
+                    let a =
+                        chart.draw_series(p.iter().map(|&c| Circle::new(c, 4, color.filled())))?;
+                    if labelled {
+                        a.label(s.label.as_str())
+                            .legend(move |(lx, ly)| Circle::new((lx + 10, ly), 4, color.filled()));
+                    }
+                } else if s.dashed {
+                    let a = chart.draw_series(DashedLineSeries::new(
+                        p.iter().copied(),
+                        6,
+                        4,
+                        color.stroke_width(2),
+                    ))?;
+                    if labelled {
+                        a.label(s.label.as_str()).legend(move |(lx, ly)| {
+                            PathElement::new(vec![(lx, ly), (lx + 8, ly)], color.stroke_width(2))
+                        });
+                    }
                 } else {
-                    chart
-                        .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))?
-                        .label(s.label.as_str())
-                        .legend(move |(lx, ly)| {
+                    let a = chart
+                        .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))?;
+                    if labelled {
+                        a.label(s.label.as_str()).legend(move |(lx, ly)| {
                             PathElement::new(vec![(lx, ly), (lx + 20, ly)], color.stroke_width(2))
                         });
+                    }
                 }
             }
             chart

@@ -141,6 +141,10 @@ pub struct Scene {
     pub basis: HarmonicBasis,
     /// The solver with its options.
     pub method: Method,
+    /// Unit of the scene's speed (`rpm`, `hz` or `rad_s`).
+    pub speed_unit: &'static str,
+    /// Fundamental Ω (rad/s) per unit of speed (includes `order`).
+    pub omega_per_speed: f64,
 }
 
 /// Names of the solver methods.
@@ -336,10 +340,10 @@ impl SceneFile {
             .into_iter()
             .filter_map(|(k, v)| v.map(|v| (k, v)))
             .collect();
-        let omega = match given.as_slice() {
-            [("rpm", v)] => v * std::f64::consts::TAU / 60.0,
-            [("hz", v)] => v * std::f64::consts::TAU,
-            [(_, v)] => *v,
+        let (speed_unit, per_unit, omega) = match given.as_slice() {
+            [("rpm", v)] => ("rpm", std::f64::consts::TAU / 60.0, *v),
+            [("hz", v)] => ("hz", std::f64::consts::TAU, *v),
+            [(_, v)] => ("rad_s", 1.0, *v),
             _ => {
                 return Err(err(
                     "fundamental",
@@ -353,7 +357,7 @@ impl SceneFile {
                 format!("must be finite and > 0, got {}", f.order),
             ));
         }
-        let omega = omega * f.order;
+        let omega = omega * per_unit * f.order;
         if !(omega.is_finite() && omega > 0.0) {
             return Err(err(
                 "fundamental",
@@ -377,6 +381,8 @@ impl SceneFile {
             model,
             basis,
             method,
+            speed_unit,
+            omega_per_speed: per_unit * f.order,
         })
     }
 }

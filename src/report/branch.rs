@@ -1,0 +1,111 @@
+//! Branch reports: CSV and the frequency-response plot (stable solid, unstable dashed, folds
+//! marked).
+
+use super::{line_plot, Axis, Series};
+use crate::continuation::Branch;
+use std::fmt::Write;
+use std::path::Path;
+
+/// CSV of a branch: parameter, stability, fold and bifurcation marks, `max|q|` per DOF, the
+/// amplitude `|Q_k|` of every DOF and order, and the Floquet multipliers' moduli.
+/// `parameter(point)` gives the first column (e.g. Ω converted to rpm).
+pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
+    let mut s = String::new();
+    let _ = write!(s, "{parameter_name},stable,fold,bifurcation");
+    for d in &branch.dofs {
+        let _ = write!(s, ",max_abs_{d}");
+    }
+    for d in &branch.dofs {
+        for k in 0..=branch.harmonics {
+            let _ = write!(s, ",amp_{d}_{k}");
+        }
+    }
+    s.push_str(",multipliers_abs\n");
+    let n = branch.dofs.len();
+    for p in &branch.points {
+        let stable = match p.stable() {
+            Some(true) => "stable",
+            Some(false) => "unstable",
+            None => "",
+        };
+        let bif = p.bifurcation.map(|b| format!("{b:?}")).unwrap_or_default();
+        let _ = write!(s, "{:e},{stable},{},{bif}", parameter(p.omega), p.fold);
+        for m in &p.max_abs {
+            let _ = write!(s, ",{m:e}");
+        }
+        for i in 0..n {
+            for k in 0..=branch.harmonics {
+                let _ = write!(s, ",{:e}", p.harmonics[k * n + i].norm());
+            }
+        }
+        let mult: Vec<String> = p
+            .floquet
+            .iter()
+            .flat_map(|f| f.multipliers.iter().map(|m| format!("{:.6e}", m.norm())))
+            .collect();
+        let _ = writeln!(s, ",{}", mult.join(";"));
+    }
+    s
+}
+
+/// The frequency-response plot of `max|q_dof|`: stable parts solid, unstable parts dashed,
+/// folds as markers.
+pub fn branch_plot(
+    path: &Path,
+    branch: &Branch,
+    dof: usize,
+    title: &str,
+    x_label: &str,
+    parameter: impl Fn(f64) -> f64,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut series: Vec<Series> = Vec::new();
+    let mut current: Vec<(f64, f64)> = Vec::new();
+    let mut current_stable = None;
+    let (mut said_stable, mut said_unstable) = (false, false);
+    let mut flush = |pts: Vec<(f64, f64)>, stable: Option<bool>, series: &mut Vec<Series>| {
+        if pts.len() < 2 {
+            return;
+        }
+        let s = match stable {
+            Some(false) => {
+                let label = if said_unstable { "" } else { "unstable" };
+                said_unstable = true;
+                Series::dashed(label, pts).with_color(1)
+            }
+            _ => {
+                let label = if said_stable { "" } else { "stable" };
+                said_stable = true;
+                Series::line(label, pts).with_color(0)
+            }
+        };
+        series.push(s);
+    };
+    for p in &branch.points {
+        let xy = (parameter(p.omega), p.max_abs[dof]);
+        let st = p.stable();
+        if current_stable.is_some() && st != current_stable {
+            // Close the segment at this point so the curve stays connected.
+            current.push(xy);
+            flush(std::mem::take(&mut current), current_stable, &mut series);
+        }
+        current_stable = st;
+        current.push(xy);
+    }
+    flush(current, current_stable, &mut series);
+    let folds: Vec<(f64, f64)> = branch
+        .points
+        .iter()
+        .filter(|p| p.fold)
+        .map(|p| (parameter(p.omega), p.max_abs[dof]))
+        .collect();
+    if !folds.is_empty() {
+        series.push(Series::markers("fold", folds).with_color(2));
+    }
+    line_plot(
+        path,
+        title,
+        &Axis::linear(x_label),
+        &Axis::linear(format!("max |{}|", branch.dofs[dof])),
+        &series,
+    )
+}
