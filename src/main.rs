@@ -85,6 +85,18 @@ enum Command {
     },
 }
 
+/// `println!` that ends the process quietly when stdout is closed (`hbal ... | head`).
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout(), $($t)*) {
+            if e.kind() == std::io::ErrorKind::BrokenPipe {
+                std::process::exit(0);
+            }
+        }
+    }};
+}
+
 /// An error with its exit code.
 struct Failure {
     code: u8,
@@ -151,8 +163,8 @@ fn load(path: &Path, method: Option<&str>, harmonics: Option<usize>) -> Result<S
 fn check(path: &Path) -> Result<u8, Failure> {
     let scene = load(path, None, None)?;
     HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
-    println!(
-        "{}: ok ({} DOFs, {} elements, Ω = {:.6} rad/s, H = {}, N = {}, solver {})",
+    say!(
+        "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s, H = {}, N = {}, solver {})",
         scene.file,
         scene.model.n_dofs(),
         scene.model.elements().len(),
@@ -172,6 +184,10 @@ fn solve(
     out: Option<&Path>,
 ) -> Result<u8, Failure> {
     let scene = load(path, method, harmonics)?;
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--out: cannot create {}", dir.display()))?;
+    }
     let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
     let mut ws = hb.workspace();
     let start = Instant::now();
@@ -206,9 +222,9 @@ fn solve(
             "dofs": dofs,
             "history": sol.history,
         });
-        println!("{doc}");
+        say!("{doc}");
     } else {
-        println!(
+        say!(
             "{}: {} ({}) after {} iterations, relative residual {:.2e}, solve {:.3} ms",
             scene.file,
             sol.termination,
@@ -217,7 +233,7 @@ fn solve(
             sol.residual(),
             solve_seconds * 1e3
         );
-        println!(
+        say!(
             "  fundamental {:.6} rad/s, H = {}, N = {}, truncation estimate {:.1e}",
             sol.basis().omega(),
             sol.basis().harmonics(),
@@ -225,13 +241,13 @@ fn solve(
             sol.truncation_estimate()
         );
         for (i, name) in sol.dof_names().iter().enumerate() {
-            println!("  max |q| {name}: {:.6e}", sol.max_abs(i));
+            say!("  max |q| {name}: {:.6e}", sol.max_abs(i));
         }
     }
     if let Some(dir) = out {
         write_outputs(dir, &sol)?;
         if !as_json {
-            println!(
+            say!(
                 "  wrote harmonics.csv, time_series.csv, time_series.svg, spectrum.svg to {}",
                 dir.display()
             );
@@ -390,12 +406,12 @@ fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure
         "seconds": td.wall_time.as_secs_f64(),
     });
     if as_json {
-        println!(
+        say!(
             "{}",
             json!({"scene": scene.file, "time_domain": td_json, "methods": rows})
         );
     } else {
-        println!(
+        say!(
             "{}: time domain (from {}) {:?} after {} periods, {} steps, {:.3} ms",
             scene.file,
             if from_orbit { "the HB orbit" } else { "rest" },
@@ -404,10 +420,10 @@ fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure
             td.steps,
             td.wall_time.as_secs_f64() * 1e3
         );
-        println!("| method | result | iterations | wall | error vs time domain |");
-        println!("|---|---|---:|---:|---:|");
+        say!("| method | result | iterations | wall | error vs time domain |");
+        say!("|---|---|---:|---:|---:|");
         for r in &rows {
-            println!(
+            say!(
                 "| {} | {} | {} | {:.3} ms | {:.2e} |",
                 r["method"].as_str().unwrap_or(""),
                 r["termination"].as_str().unwrap_or(""),
@@ -498,7 +514,7 @@ fn sweep(
                 })
             })
             .collect();
-        println!(
+        say!(
             "{}",
             json!({
                 "scene": scene.file,
@@ -517,7 +533,7 @@ fn sweep(
             .iter()
             .filter(|p| p.stable() == Some(false))
             .count();
-        println!(
+        say!(
             "{}: {} points from {from} to {to} {unit} in {:.1} ms: {}; {} folds, {} unstable points",
             scene.file,
             branch.points.len(),
@@ -537,7 +553,7 @@ fn sweep(
                 (false, Some(b)) => format!("stability change ({b:?})"),
                 _ => unreachable!("filtered"),
             };
-            println!(
+            say!(
                 "  {what} at {:.6} {unit}, max |q| = {:.6e}",
                 speed(p.omega),
                 p.max_abs[0]

@@ -225,6 +225,20 @@ fn broken_scenes_give_messages_that_name_file_and_field() {
         ("method.toml", format!("{GOOD}\n[solver]\nmethod = \"newtn\"\n"), "solver.method: unknown method `newtn`"),
         ("solver_field.toml", format!("{GOOD}\n[solver]\ntolerence = 1e-8\n"), "solver.tolerence: unknown field `tolerence`, expected one of"),
         ("gamma.toml", format!("{GOOD}\n[solver]\nmethod = \"fixed_point\"\ngamma = 1.5\n"), "solver.gamma"),
+        ("nan.toml", GOOD.replace("k = 1.0", "k = nan"), "elements[0].k: must be a finite number, got NaN"),
+        ("empty_dofs.toml", GOOD.replace("dofs = [\"x\"]", "dofs = []"), "dofs: at least one DOF is required"),
+        (
+            "nested_variant.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"mesh_stiffness\"")
+                .replace("k = 1.0", "teeth = 1\nprofile = { shape = \"constant\", stiffness = 1.0 }\ndamping = { proportinal = 1e-3 }"),
+            "elements[0].damping.proportinal: unknown variant `proportinal`",
+        ),
+        (
+            "nested_field.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"mesh_stiffness\"")
+                .replace("k = 1.0", "teeth = 1\nprofile = { shape = \"rectangular\", one_toth = 1.0, two_tooth = 2.0, contact_ratio = 1.5 }"),
+            "elements[0].profile.one_toth: unknown field `one_toth`",
+        ),
         ("no_connects.toml", GOOD.replace("connects = { x = 1.0 }", ""), "elements[0]: missing field `connects`"),
         ("no_type.toml", GOOD.replace("type = \"linear_spring\"", ""), "elements[0]: missing field `type`"),
         (
@@ -274,4 +288,41 @@ fn documented_examples_are_valid_scenes() {
         }
     }
     assert!(count >= 6, "{count} examples");
+}
+
+#[test]
+fn sweep_follows_the_backlash_branch_through_its_folds() {
+    let scene = scenes_dir().join("gear_backlash.toml");
+    let dir = std::env::temp_dir().join(format!("hbal-sweep-{}", std::process::id()));
+    let out = hbal(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--from",
+        "0.4",
+        "--to",
+        "1.6",
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["reached"], true);
+    assert!(doc["folds"].as_u64().unwrap() >= 2);
+    let points = doc["points"].as_array().unwrap();
+    assert!(
+        points.iter().any(|p| p["stable"] == false),
+        "the middle branch is unstable"
+    );
+    assert!(points.iter().any(|p| p["bifurcation"] == "Fold"));
+    let csv = std::fs::read_to_string(dir.join("branch.csv")).unwrap();
+    assert!(csv.starts_with("rad_s,stable,fold,bifurcation,max_abs_x,amp_x_0"));
+    assert!(dir.join("frequency_response_x.svg").exists());
+    let out = hbal(&["sweep", scene.to_str().unwrap(), "--from=-1", "--to", "1.6"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--from must be a finite speed > 0"));
 }

@@ -231,6 +231,7 @@ impl Continuation {
         crate::error::check_positive("continuation", "to", to)?;
         let from = basis.omega();
         let mut hb = HarmonicBalance::new(model, basis)?;
+        crate::solve::check_dense_for_continuation(&hb)?;
         let mut ws = hb.workspace();
         let layout = hb.layout();
         let m = layout.len();

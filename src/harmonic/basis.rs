@@ -23,8 +23,9 @@ pub struct HarmonicBasis {
 }
 
 impl HarmonicBasis {
-    /// Largest accepted H (the Jacobian of a 1-DOF model already has `(2H+1)²` entries).
-    pub const MAX_HARMONICS: usize = 1 << 20;
+    /// Largest accepted H (65 536; the dense Jacobian of Newton and Broyden has a lower limit,
+    /// see [`crate::solve::Newton`]).
+    pub const MAX_HARMONICS: usize = 1 << 16;
 
     /// Ω in rad/s (finite, > 0) and H harmonics (0 = static only, at most
     /// [`HarmonicBasis::MAX_HARMONICS`]); N by default.

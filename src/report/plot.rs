@@ -143,10 +143,20 @@ pub fn line_plot(
     macro_rules! draw {
         ($chart:expr) => {{
             let mut chart = $chart;
+            let fmt = |v: &f64| {
+                let a = v.abs();
+                if a != 0.0 && !(1e-3..1e4).contains(&a) {
+                    format!("{v:.0e}")
+                } else {
+                    format!("{}", (v * 1e6).round() / 1e6)
+                }
+            };
             chart
                 .configure_mesh()
                 .x_desc(x.label.as_str())
                 .y_desc(y.label.as_str())
+                .x_label_formatter(&fmt)
+                .y_label_formatter(&fmt)
                 .draw()?;
             for (i, (s, p)) in series.iter().zip(&pts).enumerate() {
                 let color = COLORS[s.color.unwrap_or(i) % COLORS.len()];

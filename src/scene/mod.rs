@@ -185,6 +185,13 @@ impl Scene {
                 let pos = e.span().map(|s| line_col(text, s.start));
                 err(pos, None, e.message().trim().replace('\n', "; "))
             })?;
+            if let Some((path, x)) = non_finite(&v, String::new()) {
+                return Err(err(
+                    None,
+                    Some(path),
+                    format!("must be a finite number, got {x}"),
+                ));
+            }
             serde_json::to_value(v).map_err(|e| err(None, None, e.to_string()))?
         };
         let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
@@ -195,6 +202,54 @@ impl Scene {
         })?;
         parsed.build(file)
     }
+}
+
+/// The path of the first NaN or infinite float in a TOML value (JSON has none).
+fn non_finite(v: &toml::Value, path: String) -> Option<(String, f64)> {
+    match v {
+        toml::Value::Float(x) if !x.is_finite() => Some((path, *x)),
+        toml::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| non_finite(x, format!("{path}[{i}]"))),
+        toml::Value::Table(t) => t.iter().find_map(|(k, x)| {
+            let p = if path.is_empty() {
+                k.clone()
+            } else {
+                format!("{path}.{k}")
+            };
+            non_finite(x, p)
+        }),
+        _ => None,
+    }
+}
+
+/// Where in `v` a key named `key` (or, with `as_value`, a string equal to it) sits, as a path.
+fn locate(v: &Value, needle: &str, as_value: bool, path: String) -> Option<String> {
+    match v {
+        Value::Object(map) => map.iter().find_map(|(k, x)| {
+            let p = if path.is_empty() {
+                k.clone()
+            } else {
+                format!("{path}.{k}")
+            };
+            if (!as_value && k == needle) || (as_value && x.as_str() == Some(needle)) {
+                Some(p)
+            } else {
+                locate(x, needle, as_value, p)
+            }
+        }),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| locate(x, needle, as_value, format!("{path}[{i}]"))),
+        _ => None,
+    }
+}
+
+/// The first back-quoted word of a serde message.
+fn quoted(message: &str) -> Option<&str> {
+    message.split('`').nth(1)
 }
 
 /// For "unknown field `x`" errors, the path of the offending field itself.
@@ -237,6 +292,9 @@ impl SceneFile {
             message,
         };
         let n = self.dofs.len();
+        if n == 0 {
+            return Err(err("dofs", "at least one DOF is required".into()));
+        }
         let matrix = |name: &str, rows: &Vec<Vec<f64>>| -> Result<DMatrix<f64>, SceneError> {
             if rows.len() != n {
                 return Err(err(
@@ -314,17 +372,40 @@ impl SceneFile {
                     format!("missing field `type` (one of: {})", known_types()),
                 ));
             }
-            let law: Box<dyn ForceLaw> = serde_path_to_error::deserialize(Value::Object(e))
+            let type_name = e
+                .get("type")
+                .and_then(|t| t.as_str())
+                .unwrap_or("")
+                .to_string();
+            let element = Value::Object(e);
+            let law: Box<dyn ForceLaw> = serde_path_to_error::deserialize(element.clone())
                 .map_err(|x| {
                     let p = x.path().to_string();
                     let mut message = x.into_inner().to_string();
-                    let p = field_path(p, &message);
-                    let path = if p == "." {
-                        format!("elements[{i}]")
+                    // typetag buffers the element, so serde's path stops at it: find the
+                    // offending key or value inside the element ourselves.
+                    let inner = if message.starts_with("unknown field") {
+                        quoted(&message).and_then(|k| locate(&element, k, false, String::new()))
+                    } else if message.starts_with("unknown variant") {
+                        quoted(&message).and_then(|v| {
+                            locate(&element, v, true, String::new())
+                                .or_else(|| locate(&element, v, false, String::new()))
+                        })
                     } else {
-                        at(&p)
+                        None
                     };
-                    if message.contains("unknown variant") || message.contains("unknown type") {
+                    let path = match inner {
+                        Some(p) => at(&p),
+                        None => {
+                            let p = field_path(p, &message);
+                            if p == "." {
+                                format!("elements[{i}]")
+                            } else {
+                                at(&p)
+                            }
+                        }
+                    };
+                    if quoted(&message) == Some(type_name.as_str()) {
                         message = format!("{message}; known element types: {}", known_types());
                     }
                     err(&path, message)

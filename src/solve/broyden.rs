@@ -7,7 +7,9 @@
 
 use super::lu;
 use super::problem::HbProblem;
-use super::run::{check_tolerance, initial_x, run, HbSolver, HbState, Limits, Progress};
+use super::run::{
+    check_dense, check_tolerance, initial_x, run, HbSolver, HbState, Limits, Progress,
+};
 use crate::error::Result;
 use crate::residual::{HarmonicBalance, Workspace};
 use crate::solution::{Solution, Termination};
@@ -101,6 +103,7 @@ impl Broyden {
         ws: &mut Workspace,
     ) -> Result<Solution> {
         check_tolerance("broyden", self.tolerance)?;
+        check_dense("broyden", hb)?;
         let x0 = initial_x(hb, initial, true)?;
         let limits = Limits {
             tolerance: self.tolerance,

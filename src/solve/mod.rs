@@ -21,4 +21,9 @@ pub use fixed_point::{FixedPoint, FixedPointSolver};
 pub use method::Method;
 pub use newton::{Newton, NewtonSolver};
 pub use problem::HbProblem;
-pub use run::{HbSolver, HbState, Progress};
+pub use run::{HbSolver, HbState, Progress, MAX_DENSE_UNKNOWNS};
+
+/// The dense-Jacobian guard, for continuation.
+pub(crate) fn check_dense_for_continuation(hb: &crate::HarmonicBalance) -> crate::Result<()> {
+    run::check_dense("continuation", hb)
+}

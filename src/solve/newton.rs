@@ -8,7 +8,9 @@
 
 use super::lu;
 use super::problem::HbProblem;
-use super::run::{check_tolerance, initial_x, run, HbSolver, HbState, Limits, Progress};
+use super::run::{
+    check_dense, check_tolerance, initial_x, run, HbSolver, HbState, Limits, Progress,
+};
 use crate::error::Result;
 use crate::residual::{HarmonicBalance, Workspace};
 use crate::solution::{Solution, Termination};
@@ -94,6 +96,7 @@ impl Newton {
         ws: &mut Workspace,
     ) -> Result<Solution> {
         check_tolerance("newton", self.tolerance)?;
+        check_dense("newton", hb)?;
         let x0 = initial_x(hb, initial, true)?;
         let limits = Limits {
             tolerance: self.tolerance,

@@ -65,6 +65,27 @@ pub(crate) struct Limits {
     pub timeout: Option<Duration>,
 }
 
+/// Largest number of real unknowns for the dense Jacobian of Newton and Broyden
+/// (8192² doubles = 512 MiB).
+pub const MAX_DENSE_UNKNOWNS: usize = 8192;
+
+/// Refuses a dense Jacobian that would not fit in memory, with advice.
+pub(crate) fn check_dense(context: &str, hb: &HarmonicBalance) -> Result<()> {
+    let m = hb.layout().len();
+    if m > MAX_DENSE_UNKNOWNS {
+        return Err(Error::invalid(
+            context,
+            "unknowns n(2H+1)",
+            m as f64,
+            format!(
+                "<= {MAX_DENSE_UNKNOWNS} for a dense Jacobian ({:.1} GiB here): use fixed_point or anderson, or fewer harmonics",
+                (m * m * 8) as f64 / (1u64 << 30) as f64
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Checks a relative tolerance.
 pub(crate) fn check_tolerance(context: &str, tolerance: f64) -> Result<()> {
     if tolerance.is_finite() && (0.0..1.0).contains(&tolerance) {
