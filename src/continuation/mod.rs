@@ -130,7 +130,7 @@ pub struct Continuation {
     pub tolerance: f64,
     /// Corrector iterations before the step is halved. Default 8.
     pub max_corrector: usize,
-    /// Floquet steps per period (`Some(0)`: no stability). Default: 8H, at least 64.
+    /// Floquet steps per period (`Some(0)`: no stability). Default: 4H, at least 64.
     pub floquet_steps: Option<usize>,
 }
 
@@ -384,7 +384,7 @@ impl Continuation {
         };
         let steps = self
             .floquet_steps
-            .unwrap_or((8 * hb.basis().harmonics()).max(64));
+            .unwrap_or((4 * hb.basis().harmonics()).max(64));
         let floquet = if steps > 0 {
             Some(floquet(model, &sol, steps.max(16))?)
         } else {
