@@ -326,3 +326,68 @@ fn sweep_follows_the_backlash_branch_through_its_folds() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--from must be a finite speed > 0"));
 }
+
+#[test]
+fn parameter_sweep_over_a_scene_field() {
+    let scene = scenes_dir().join("duffing.toml");
+    let out = hbal(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--parameter",
+        "elements[0].alpha",
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--points",
+        "11",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let points = doc["points"].as_array().unwrap();
+    assert_eq!(points.len(), 11);
+    assert_eq!(points[10]["parameter"], 1.0);
+    // α = 1 is the scene itself: the same amplitude as a plain solve.
+    let solve = hbal(&["solve", scene.to_str().unwrap(), "--json"]);
+    let doc2: serde_json::Value = serde_json::from_slice(&solve.stdout).unwrap();
+    let a = points[10]["max_abs"][0].as_f64().unwrap();
+    let b = doc2["dofs"][0]["max_abs"].as_f64().unwrap();
+    assert!((a - b).abs() < 1e-9 * b, "{a} vs {b}");
+    // A jump (fold in the load amplitude) stops the sweep with exit 1 and a reason.
+    let out = hbal(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--parameter",
+        "loads[0].cos",
+        "--from",
+        "0.01",
+        "--to",
+        "0.3",
+        "--points",
+        "30",
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(doc["stop"]
+        .as_str()
+        .unwrap()
+        .contains("no convergence at parameter"));
+    let out = hbal(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--parameter",
+        "elements[0].alfa",
+        "--from",
+        "0",
+        "--to",
+        "1",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no field `alfa`"));
+}

@@ -28,6 +28,8 @@ use num_complex::Complex64;
 /// One periodic solution on a branch.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BranchPoint {
+    /// The swept parameter (Ω itself for a frequency sweep).
+    pub parameter: f64,
     /// Fundamental Ω (rad/s).
     pub omega: f64,
     /// Harmonics, harmonic-major (`Q[k * n + i]`).
@@ -70,6 +72,12 @@ pub enum BranchStop {
         /// Where.
         omega: f64,
     },
+    /// Newton did not converge at this parameter value (a parameter sweep does not follow
+    /// folds: use a frequency sweep there).
+    NotConverged {
+        /// The parameter value.
+        parameter: f64,
+    },
     /// The first point did not converge.
     StartFailed {
         /// The solver's termination.
@@ -90,6 +98,12 @@ impl std::fmt::Display for BranchStop {
             }
             BranchStop::StartFailed { reason } => {
                 write!(f, "first point did not converge: {reason}")
+            }
+            BranchStop::NotConverged { parameter } => {
+                write!(
+                    f,
+                    "no convergence at parameter {parameter} (a fold in the parameter?)"
+                )
             }
         }
     }
@@ -401,6 +415,7 @@ impl Continuation {
         };
         let max_abs = (0..model.n_dofs()).map(|i| sol.max_abs(i)).collect();
         branch.points.push(BranchPoint {
+            parameter: omega,
             omega,
             harmonics: sol.harmonics,
             max_abs,
@@ -411,4 +426,57 @@ impl Continuation {
         });
         Ok(())
     }
+}
+
+/// A warm-started sweep over any parameter: `build(p)` gives the model and basis at `p`; each
+/// point starts Newton from the previous one. It stops with [`BranchStop::NotConverged`] where
+/// Newton fails (it does not follow folds). Floquet steps as in [`Continuation`].
+pub fn parameter_sweep(
+    values: &[f64],
+    mut build: impl FnMut(f64) -> Result<(Model, HarmonicBasis)>,
+    floquet_steps: Option<usize>,
+    mut progress: impl FnMut(f64),
+) -> Result<Branch> {
+    let mut branch: Option<Branch> = None;
+    let mut previous: Option<Vec<Complex64>> = None;
+    let cont = Continuation {
+        floquet_steps,
+        ..Continuation::default()
+    };
+    for (i, &p) in values.iter().enumerate() {
+        let (model, basis) = build(p)?;
+        let hb = HarmonicBalance::new(&model, basis)?;
+        crate::solve::check_dense_for_continuation(&hb)?;
+        let mut ws = hb.workspace();
+        let newton = Newton::new().with_tolerance(cont.tolerance)?;
+        let sol = match &previous {
+            Some(q) if q.len() == hb.len() => newton.solve_from(&hb, q, &mut ws)?,
+            _ => newton.solve(&hb, &mut ws)?,
+        };
+        let b = branch.get_or_insert_with(|| Branch {
+            dofs: model.dof_names().to_vec(),
+            harmonics: basis.harmonics(),
+            points: Vec::new(),
+            stop: BranchStop::Reached,
+        });
+        if !sol.is_converged() {
+            b.stop = if i == 0 {
+                BranchStop::StartFailed {
+                    reason: sol.termination.to_string(),
+                }
+            } else {
+                BranchStop::NotConverged { parameter: p }
+            };
+            break;
+        }
+        let mut x = vec![0.0; hb.layout().len()];
+        hb.layout().pack(sol.harmonics(), &mut x);
+        cont.push_point(b, &model, &hb, &x, basis.omega(), sol.residual(), false)?;
+        if let Some(last) = b.points.last_mut() {
+            last.parameter = p;
+        }
+        previous = Some(sol.harmonics().to_vec());
+        progress((i + 1) as f64 / values.len() as f64);
+    }
+    branch.ok_or_else(|| Error::invalid("parameter sweep", "values", 0.0, "at least one value"))
 }

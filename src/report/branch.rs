@@ -8,7 +8,7 @@ use std::path::Path;
 
 /// CSV of a branch: parameter, stability, fold and bifurcation marks, `max|q|` per DOF, the
 /// amplitude `|Q_k|` of every DOF and order, and the Floquet multipliers' moduli.
-/// `parameter(point)` gives the first column (e.g. Ω converted to rpm).
+/// `parameter(p)` maps the point's swept parameter to the first column (e.g. Ω to rpm).
 pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
     let mut s = String::new();
     let _ = write!(s, "{parameter_name},stable,fold,bifurcation");
@@ -29,7 +29,7 @@ pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64)
             None => "",
         };
         let bif = p.bifurcation.map(|b| format!("{b:?}")).unwrap_or_default();
-        let _ = write!(s, "{:e},{stable},{},{bif}", parameter(p.omega), p.fold);
+        let _ = write!(s, "{:e},{stable},{},{bif}", parameter(p.parameter), p.fold);
         for m in &p.max_abs {
             let _ = write!(s, ",{m:e}");
         }
@@ -81,7 +81,7 @@ pub fn branch_plot(
         series.push(s);
     };
     for p in &branch.points {
-        let xy = (parameter(p.omega), p.max_abs[dof]);
+        let xy = (parameter(p.parameter), p.max_abs[dof]);
         let st = p.stable();
         if current_stable.is_some() && st != current_stable {
             // Close the segment at this point so the curve stays connected.
@@ -96,7 +96,7 @@ pub fn branch_plot(
         .points
         .iter()
         .filter(|p| p.fold)
-        .map(|p| (parameter(p.omega), p.max_abs[dof]))
+        .map(|p| (parameter(p.parameter), p.max_abs[dof]))
         .collect();
     if !folds.is_empty() {
         series.push(Series::markers("fold", folds).with_color(2));

@@ -166,6 +166,29 @@ impl Scene {
     /// Parses scene text; the format follows the name's extension (`.json` or TOML).
     #[allow(clippy::should_implement_trait)]
     pub fn from_str(text: &str, file: &str) -> Result<Scene, SceneError> {
+        Self::from_value(Self::parse_value(text, file)?, file)
+    }
+
+    /// Builds a scene from an already parsed document (see [`Scene::parse_value`],
+    /// [`set_parameter`]).
+    pub fn from_value(value: Value, file: &str) -> Result<Scene, SceneError> {
+        let err = |position, path: Option<String>, message: String| SceneError {
+            file: file.to_string(),
+            position,
+            path,
+            message,
+        };
+        let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
+            let path = e.path().to_string();
+            let message = e.into_inner().to_string();
+            let path = field_path(path, &message);
+            err(None, (path != ".").then_some(path), message)
+        })?;
+        parsed.build(file)
+    }
+
+    /// Parses scene text into a document tree (JSON values) with the file's syntax checks.
+    pub fn parse_value(text: &str, file: &str) -> Result<Value, SceneError> {
         let err = |position, path: Option<String>, message: String| SceneError {
             file: file.to_string(),
             position,
@@ -194,13 +217,7 @@ impl Scene {
             }
             serde_json::to_value(v).map_err(|e| err(None, None, e.to_string()))?
         };
-        let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
-            let path = e.path().to_string();
-            let message = e.into_inner().to_string();
-            let path = field_path(path, &message);
-            err(None, (path != ".").then_some(path), message)
-        })?;
-        parsed.build(file)
+        Ok(value)
     }
 }
 
@@ -532,6 +549,41 @@ impl SolverSpec {
         };
         Ok(method)
     }
+}
+
+/// Sets the number at `path` (e.g. `elements[0].alpha`, `loads[1].cos`, `damping[0][0]`,
+/// `fundamental.rpm`) in a parsed scene document; errors name what is missing.
+pub fn set_parameter(doc: &mut Value, path: &str, x: f64) -> Result<(), String> {
+    let mut cur = doc;
+    let mut tokens = Vec::new();
+    for part in path.split('.') {
+        let (key, rest) = part.split_at(part.find('[').unwrap_or(part.len()));
+        if !key.is_empty() {
+            tokens.push(Err(key.to_string()));
+        }
+        for idx in rest.split('[').skip(1) {
+            let i: usize = idx
+                .trim_end_matches(']')
+                .parse()
+                .map_err(|_| format!("`{path}`: `[{idx}` is not an index"))?;
+            tokens.push(Ok(i));
+        }
+    }
+    for t in &tokens {
+        cur = match t {
+            Err(k) => cur
+                .get_mut(k.as_str())
+                .ok_or_else(|| format!("`{path}`: no field `{k}`"))?,
+            Ok(i) => cur
+                .get_mut(*i)
+                .ok_or_else(|| format!("`{path}`: no entry [{i}]"))?,
+        };
+    }
+    if !cur.is_number() {
+        return Err(format!("`{path}` is not a number in the scene"));
+    }
+    *cur = serde_json::json!(x);
+    Ok(())
 }
 
 /// The built-in element types (users' laws compiled in are accepted too).
