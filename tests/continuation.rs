@@ -148,3 +148,27 @@ fn stability_flags_agree_with_time_integration() {
         }
     }
 }
+
+/// A sweep that cannot continue stops with a clear reason and keeps what it computed.
+#[test]
+fn stuck_continuation_keeps_its_branch() {
+    let model = Duffing::default().model().unwrap();
+    let branch = Continuation {
+        max_corrector: 1,
+        tolerance: 1e-15,
+        min_step: 1e-3,
+        ..Continuation::default()
+    }
+    .run(&model, HarmonicBasis::new(0.5, 7).unwrap(), 3.0, |_| {})
+    .unwrap();
+    assert!(
+        matches!(branch.stop, BranchStop::StepTooSmall { .. }),
+        "{}",
+        branch.stop
+    );
+    assert!(!branch.points.is_empty());
+    assert!(branch
+        .stop
+        .to_string()
+        .contains("step size under its minimum"));
+}
