@@ -157,7 +157,8 @@ impl Solution {
             .sum()
     }
 
-    /// `q_dof` at `points` equidistant angles over one period, starting at θ = 0.
+    /// `q_dof` at `points` equidistant angles over one period, starting at θ = 0 (by an inverse
+    /// FFT when `points >= 2H+1`, so `O(points log points)`).
     pub fn time_series(&self, dof: usize, points: usize) -> Vec<f64> {
         let n = self.dofs.len();
         assert!(
@@ -165,6 +166,18 @@ impl Solution {
             "DOF index {dof} out of range: the model has {n} DOFs"
         );
         let h = self.basis.harmonics();
+        if points > 2 * h && points >= 2 {
+            if let Ok(basis) =
+                HarmonicBasis::new(self.basis.omega(), h).and_then(|b| b.with_samples(points))
+            {
+                let plan = crate::harmonic::AftPlan::new(basis);
+                let mut scratch = plan.make_scratch();
+                let q: Vec<Complex64> = (0..=h).map(|k| self.harmonics[k * n + dof]).collect();
+                let mut out = vec![0.0; points];
+                plan.synthesize_into(&q, |_| Complex64::new(1.0, 0.0), &mut out, &mut scratch);
+                return out;
+            }
+        }
         (0..points)
             .map(|j| {
                 // e^{ikθ} by the recurrence: one sin/cos per point.
