@@ -121,3 +121,28 @@ fn undamped_resonance_is_an_error() {
     );
     assert!(msg.contains("harmonic 2"), "{msg}");
 }
+
+/// The FFT-based time series agrees with direct evaluation, also for many harmonics.
+#[test]
+fn time_series_matches_direct_evaluation() {
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .element("spring", &[("x", 1.0)], LinearSpring::new(3.0, 0.2))
+        .load("x", 0, 0.5, 0.0)
+        .load("x", 1, 1.0, 0.3)
+        .load("x", 300, 0.2, -0.1)
+        .build()
+        .unwrap();
+    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(1.1, 300).unwrap()).unwrap();
+    let sol = FixedPoint::new().solve(&hb, &mut hb.workspace()).unwrap();
+    for points in [601, 1024, 4096] {
+        let series = sol.time_series(0, points);
+        for j in (0..points).step_by(37) {
+            let theta = std::f64::consts::TAU * j as f64 / points as f64;
+            assert!((series[j] - sol.displacement(0, theta)).abs() < 1e-13);
+        }
+    }
+    // Fewer points than 2H+1 use the direct sum.
+    let coarse = sol.time_series(0, 100);
+    assert!((coarse[7] - sol.displacement(0, std::f64::consts::TAU * 7.0 / 100.0)).abs() < 1e-13);
+}
