@@ -166,8 +166,10 @@ fn load(path: &Path, method: Option<&str>, harmonics: Option<usize>) -> Result<S
         scene.method = method_named(&text, &scene.file, name)?;
     }
     if let Some(h) = harmonics {
-        scene.basis = HarmonicBasis::new(scene.basis.omega(), h)
+        let basis = HarmonicBasis::new(scene.basis.omega(), h)
             .with_context(|| format!("{}: --harmonics", scene.file))?;
+        // Keep the scene's N where it can still carry H harmonics.
+        scene.basis = basis.with_samples(scene.basis.samples()).unwrap_or(basis);
     }
     Ok(scene)
 }

@@ -366,6 +366,13 @@ impl<'m> HarmonicBalance<'m> {
             );
             let law = e.law();
             law.derivatives_batch(&self.thetas, &b.u, &b.du, &mut b.gu, &mut b.gdu);
+            // Jump samples take the mean of both one-sided limits, as in `aft_into`.
+            let delta = 1e-7 * TAU / self.basis.samples() as f64;
+            for &j in &act.jump_samples {
+                let (t, u, du) = (self.thetas[j], b.u[j], b.du[j]);
+                b.gdu[j] = 0.5
+                    * (law.derivatives(t - delta, u, du).1 + law.derivatives(t + delta, u, du).1);
+            }
             let d0 = e.linear_part().damping;
             for ((f, g), du) in b.f.iter_mut().zip(&b.gdu).zip(&b.du) {
                 *f = (g - d0) * du / omega;

@@ -166,7 +166,8 @@ impl Solution {
             "DOF index {dof} out of range: the model has {n} DOFs"
         );
         let h = self.basis.harmonics();
-        if points > 2 * h && points >= 2 {
+        // An FFT (with its planning) pays off once the direct sum has many terms.
+        if points > 2 * h && points >= 2 && points * h > 20_000 {
             if let Ok(basis) =
                 HarmonicBasis::new(self.basis.omega(), h).and_then(|b| b.with_samples(points))
             {

@@ -391,3 +391,51 @@ fn parameter_sweep_over_a_scene_field() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no field `alfa`"));
 }
+
+#[test]
+fn parameter_sweep_keeps_points_before_an_invalid_value() {
+    let scene = scenes_dir().join("gear_backlash.toml");
+    let dir = std::env::temp_dir().join(format!("hbal-psweep-{}", std::process::id()));
+    // The half backlash goes negative half way: the scene is invalid there.
+    let out = hbal(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--parameter",
+        "elements[0].half_backlash",
+        "--from",
+        "1.0",
+        "--to=-0.6",
+        "--points",
+        "9",
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{doc}");
+    assert!(doc["points"].as_array().unwrap().len() >= 4, "{doc}");
+    assert!(
+        doc["stop"].as_str().unwrap().contains("half_backlash"),
+        "{doc}"
+    );
+    assert!(dir.join("branch.csv").exists());
+    // Case-insensitive JSON extension, and --harmonics keeps the scene's N when it can.
+    let upper = dir.join("SCENE.JSON");
+    std::fs::copy(scenes_dir().join("duffing_resonance.json"), &upper).unwrap();
+    assert!(hbal(&["check", upper.to_str().unwrap()]).status.success());
+    let out = hbal(&[
+        "solve",
+        scenes_dir()
+            .join("two_shaft_6000rpm.toml")
+            .to_str()
+            .unwrap(),
+        "--harmonics",
+        "16",
+        "--json",
+    ]);
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        doc["samples"], 256,
+        "the scene's default N for H = 32 carries H = 16 as well"
+    );
+}

@@ -343,3 +343,22 @@ fn accelerated_solver_bad_input() {
         assert!((sol.cos_sin(0, 0).0 - 1.0).abs() < 1e-12);
     }
 }
+
+/// A solve that meets the tolerance on its last allowed iteration is converged, not
+/// "maximum iterations" (argmin checks the limit first).
+#[test]
+fn converged_on_the_last_allowed_iteration() {
+    let model = GearBacklash::default().model().unwrap();
+    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(0.5, 16).unwrap()).unwrap();
+    let sol = Newton::new()
+        .with_max_iterations(1)
+        .solve(&hb, &mut hb.workspace())
+        .unwrap();
+    assert_eq!(sol.termination, Termination::Converged, "{:?}", sol.history);
+    // Already converged at the warm start with no iterations allowed.
+    let again = Newton::new()
+        .with_max_iterations(0)
+        .solve_from(&hb, sol.harmonics(), &mut hb.workspace())
+        .unwrap();
+    assert_eq!(again.termination, Termination::Converged);
+}

@@ -42,6 +42,8 @@ pub struct BranchPoint {
     pub floquet: Option<Floquet>,
     /// A turning point of the branch lies between the previous point and this one.
     pub fold: bool,
+    /// Its Ω, interpolated from the tangents at both points (Ω'(s) linear in arclength).
+    pub fold_omega: Option<f64>,
     /// Stability changed between the previous point and this one, with this kind of
     /// critical multiplier.
     pub bifurcation: Option<Bifurcation>,
@@ -78,6 +80,13 @@ pub enum BranchStop {
         /// The parameter value.
         parameter: f64,
     },
+    /// The scene could not be built at this parameter value (e.g. a negative stiffness).
+    InvalidParameter {
+        /// The parameter value.
+        parameter: f64,
+        /// What is wrong.
+        reason: String,
+    },
     /// The first point did not converge.
     StartFailed {
         /// The solver's termination.
@@ -98,6 +107,9 @@ impl std::fmt::Display for BranchStop {
             }
             BranchStop::StartFailed { reason } => {
                 write!(f, "first point did not converge: {reason}")
+            }
+            BranchStop::InvalidParameter { parameter, reason } => {
+                write!(f, "invalid scene at parameter {parameter}: {reason}")
             }
             BranchStop::NotConverged { parameter } => {
                 write!(
@@ -136,7 +148,7 @@ pub struct Continuation {
     pub initial_step: f64,
     /// Smallest step before giving up. Default 1e-7.
     pub min_step: f64,
-    /// Largest step. Default 0.5.
+    /// Largest step. Default 1.0.
     pub max_step: f64,
     /// Point limit. Default 10 000.
     pub max_points: usize,
@@ -153,7 +165,7 @@ impl Default for Continuation {
         Self {
             initial_step: 0.05,
             min_step: 1e-7,
-            max_step: 0.5,
+            max_step: 1.0,
             max_points: 10_000,
             tolerance: 1e-10,
             max_corrector: 8,
@@ -264,7 +276,11 @@ impl Continuation {
             };
             return Ok(branch);
         }
-        let ext = hb.norm(hb.external_load()).max(f64::MIN_POSITIVE);
+        // Residuals relative to the load (or the load of the split, or 1 without either).
+        let ext = [hb.norm(hb.external_load()), hb.norm(hb.split_load()), 1.0]
+            .into_iter()
+            .find(|v| *v > 0.0)
+            .unwrap_or(1.0);
         let mut x = vec![0.0; m];
         layout.pack(start.harmonics(), &mut x);
         let sx = (layout.norm(&x) / (m as f64).sqrt()).max(1e-12 * ext.max(1.0));
@@ -327,6 +343,16 @@ impl Continuation {
                 if !o_new.is_finite() {
                     break;
                 }
+                if it + 1 == self.max_corrector && o_new > 0.0 {
+                    // The last update gets its check too.
+                    if let Ok(Some(rel)) =
+                        bordered.factor(&mut hb, &mut ws, &x_new, o_new, &t, sx, so, ext)
+                    {
+                        if rel <= self.tolerance {
+                            converged = Some((it + 1, rel));
+                        }
+                    }
+                }
             }
             let Some((iterations, rel)) = converged else {
                 step *= 0.5;
@@ -340,9 +366,23 @@ impl Continuation {
             let old_t_omega = t[m];
             self.tangent(&mut bordered, &mut t);
             let fold = old_t_omega * t[m] < 0.0;
+            // dΩ/ds goes linearly from old to new tangent over the step h: zero at
+            // s* = h tp/(tp - tn), where Ω = Ω_prev + s_Ω tp s*/2.
+            let fold_omega = fold.then(|| {
+                let h = ((0..m)
+                    .map(|i| ((x_new[i] - x[i]) / sx).powi(2))
+                    .sum::<f64>()
+                    + ((o_new - omega) / so).powi(2))
+                .sqrt();
+                let s_star = h * old_t_omega / (old_t_omega - t[m]);
+                omega + so * old_t_omega * s_star / 2.0
+            });
             x.copy_from_slice(&x_new);
             omega = o_new;
             self.push_point(&mut branch, model, &hb, &x, omega, rel, fold)?;
+            if let Some(last) = branch.points.last_mut() {
+                last.fold_omega = fold_omega;
+            }
             progress(((omega - from) / (to - from)).clamp(0.0, 1.0));
             if (omega - to) * direction >= 0.0 {
                 branch.stop = BranchStop::Reached;
@@ -422,6 +462,7 @@ impl Continuation {
             residual,
             floquet,
             fold,
+            fold_omega: None,
             bifurcation,
         });
         Ok(())
@@ -444,7 +485,20 @@ pub fn parameter_sweep(
         ..Continuation::default()
     };
     for (i, &p) in values.iter().enumerate() {
-        let (model, basis) = build(p)?;
+        let (model, basis) = match build(p) {
+            Ok(v) => v,
+            Err(e) => match branch.as_mut() {
+                // Keep the points so far.
+                Some(b) => {
+                    b.stop = BranchStop::InvalidParameter {
+                        parameter: p,
+                        reason: e.to_string(),
+                    };
+                    break;
+                }
+                None => return Err(e),
+            },
+        };
         let hb = HarmonicBalance::new(&model, basis)?;
         crate::solve::check_dense_for_continuation(&hb)?;
         let mut ws = hb.workspace();

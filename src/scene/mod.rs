@@ -195,7 +195,7 @@ impl Scene {
             path,
             message,
         };
-        let value: Value = if file.ends_with(".json") {
+        let value: Value = if is_json(file) {
             serde_json::from_str(text).map_err(|e| {
                 err(
                     Some((e.line(), e.column())),
@@ -284,6 +284,11 @@ fn field_path(path: String, message: &str) -> String {
     } else {
         format!("{path}.{name}")
     }
+}
+
+/// `.json` (any case) is JSON; everything else TOML.
+fn is_json(file: &str) -> bool {
+    file.to_ascii_lowercase().ends_with(".json")
 }
 
 fn strip_position(message: &str) -> String {
@@ -593,7 +598,7 @@ pub fn known_types() -> String {
 
 /// Re-reads a scene's solver settings with another method name (for `--method`).
 pub fn method_named(scene_text: &str, file: &str, name: &str) -> Result<Method, SceneError> {
-    let value: Value = if file.ends_with(".json") {
+    let value: Value = if is_json(file) {
         serde_json::from_str(scene_text).unwrap_or(Value::Null)
     } else {
         toml::from_str::<toml::Value>(scene_text)

@@ -186,7 +186,7 @@ impl BroydenSolver {
         if !self.inverse.iter().all(|v| v.is_finite()) {
             return Some(Termination::SingularJacobian);
         }
-        self.fresh = true;
+        self.fresh = exact;
         self.stalled = 0;
         None
     }

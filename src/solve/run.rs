@@ -159,7 +159,15 @@ where
         reason: e.to_string(),
     })?;
     let progress = result.solver.progress();
+    // argmin checks the iteration limit before the target cost: a solve that meets the
+    // tolerance on its last allowed iteration (or starts converged) is converged.
+    let met = progress
+        .history
+        .last()
+        .is_some_and(|r| *r <= limits.tolerance)
+        && progress.termination.is_none();
     let termination = match result.state.get_termination_reason() {
+        _ if met => Termination::Converged,
         Some(TerminationReason::TargetCostReached) | Some(TerminationReason::SolverConverged) => {
             Termination::Converged
         }
