@@ -8,7 +8,8 @@
 use super::lu;
 use super::problem::HbProblem;
 use super::run::{
-    check_dense, check_tolerance, initial_x, run, HbSolver, HbState, Limits, Progress,
+    armijo, check_dense, check_tolerance, initial_x, nonfinite, run, HbSolver, HbState, Limits,
+    Progress,
 };
 use crate::error::Result;
 use crate::residual::{HarmonicBalance, Workspace};
@@ -204,19 +205,15 @@ impl BroydenSolver {
                 }
             }
         }
-        let mut alpha = 1.0;
-        for _ in 0..5 {
-            for ((t, x), d) in self.x_trial.iter_mut().zip(&self.progress.x).zip(&self.dx) {
-                *t = x + alpha * d;
-            }
-            if let Ok(rel) = p.residual(&self.x_trial, &mut self.r_trial, None) {
-                if rel.is_finite() && rel <= (1.0 - 1e-4 * alpha) * self.rel {
-                    return Some(rel);
-                }
-            }
-            alpha *= 0.5;
-        }
-        None
+        armijo(
+            p,
+            &self.progress.x,
+            &self.dx,
+            self.rel,
+            4,
+            &mut self.x_trial,
+            &mut self.r_trial,
+        )
     }
 }
 
@@ -313,11 +310,5 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for BroydenSolver {
             return Ok((self.progress.stop(state, t), None));
         }
         Ok((state.cost(rel), None))
-    }
-}
-
-fn nonfinite(what: &str) -> Termination {
-    Termination::NonFinite {
-        what: what.to_string(),
     }
 }

@@ -9,7 +9,8 @@
 use super::lu;
 use super::problem::HbProblem;
 use super::run::{
-    check_dense, check_tolerance, initial_x, run, HbSolver, HbState, Limits, Progress,
+    armijo, check_dense, check_tolerance, initial_x, nonfinite, run, HbSolver, HbState, Limits,
+    Progress,
 };
 use crate::error::Result;
 use crate::residual::{HarmonicBalance, Workspace};
@@ -191,43 +192,30 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
             ));
         }
         p.count_iteration();
-        let mut alpha = 1.0;
-        for _ in 0..=self.options.max_halvings {
-            for ((t, x), d) in self.x_trial.iter_mut().zip(&self.progress.x).zip(&self.dx) {
-                *t = x + alpha * d;
+        let Some(rel) = armijo(
+            p,
+            &self.progress.x,
+            &self.dx,
+            self.rel,
+            self.options.max_halvings,
+            &mut self.x_trial,
+            &mut self.r_trial,
+        ) else {
+            return Ok((
+                self.progress.stop(state, Termination::LineSearchFailed),
+                None,
+            ));
+        };
+        std::mem::swap(&mut self.progress.x, &mut self.x_trial);
+        std::mem::swap(&mut self.r, &mut self.r_trial);
+        self.rel = rel;
+        self.progress.record(rel);
+        // The Jacobian for the next step, unless this one is the last.
+        if rel > self.options.tolerance {
+            if let Err(e) = p.residual(&self.progress.x, &mut self.r, Some(&mut self.jac)) {
+                return Ok((self.progress.stop(state, nonfinite(&e.to_string())), None));
             }
-            let trial = p.residual(&self.x_trial, &mut self.r_trial, None);
-            if let Ok(rel) = trial {
-                if rel.is_finite() && rel <= (1.0 - 1e-4 * alpha) * self.rel {
-                    std::mem::swap(&mut self.progress.x, &mut self.x_trial);
-                    std::mem::swap(&mut self.r, &mut self.r_trial);
-                    self.rel = rel;
-                    self.progress.record(rel);
-                    // The Jacobian for the next step, unless this one is the last.
-                    if rel > self.options.tolerance {
-                        if let Err(e) =
-                            p.residual(&self.progress.x, &mut self.r, Some(&mut self.jac))
-                        {
-                            return Ok((
-                                self.progress.stop(state, nonfinite(&e.to_string())),
-                                None,
-                            ));
-                        }
-                    }
-                    return Ok((state.cost(rel), None));
-                }
-            }
-            alpha *= 0.5;
         }
-        Ok((
-            self.progress.stop(state, Termination::LineSearchFailed),
-            None,
-        ))
-    }
-}
-
-fn nonfinite(what: &str) -> Termination {
-    Termination::NonFinite {
-        what: what.to_string(),
+        Ok((state.cost(rel), None))
     }
 }

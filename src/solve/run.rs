@@ -200,3 +200,37 @@ where
         wall_time: start.elapsed(),
     })
 }
+
+/// A non-finite termination naming `what`.
+pub(crate) fn nonfinite(what: &str) -> Termination {
+    Termination::NonFinite {
+        what: what.to_string(),
+    }
+}
+
+/// Backtracking line search: the largest `α ∈ {1, ½, ¼, …}` (at most `halvings` halvings) with
+/// `‖R(x + α dx)‖ <= (1 - 10⁻⁴ α) ‖R(x)‖` (Armijo). Leaves the accepted point in `x_trial`,
+/// its residual in `r_trial`, and returns its relative residual.
+pub(crate) fn armijo(
+    p: &HbProblem,
+    x: &[f64],
+    dx: &[f64],
+    rel: f64,
+    halvings: usize,
+    x_trial: &mut [f64],
+    r_trial: &mut [f64],
+) -> Option<f64> {
+    let mut alpha = 1.0;
+    for _ in 0..=halvings {
+        for ((t, xi), d) in x_trial.iter_mut().zip(x).zip(dx) {
+            *t = xi + alpha * d;
+        }
+        if let Ok(r) = p.residual(x_trial, r_trial, None) {
+            if r.is_finite() && r <= (1.0 - 1e-4 * alpha) * rel {
+                return Some(r);
+            }
+        }
+        alpha *= 0.5;
+    }
+    None
+}
