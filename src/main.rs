@@ -239,11 +239,12 @@ fn solve(
         say!("{doc}");
     } else {
         say!(
-            "{}: {} ({}) after {} iterations, relative residual {:.2e}, solve {:.3} ms",
+            "{}: {} ({}) after {} iteration{}, relative residual {:.2e}, solve {:.3} ms",
             scene.file,
             sol.termination,
             scene.method.name(),
             sol.stats.iterations,
+            if sol.stats.iterations == 1 { "" } else { "s" },
             sol.residual(),
             solve_seconds * 1e3
         );
