@@ -251,17 +251,7 @@ impl<'m> HarmonicBalance<'m> {
         out.fill(Complex64::default());
         for act in &self.active {
             let e = &self.model.elements()[act.index];
-            for k in 0..=h {
-                ws.uk[k] = e.gather(&q[k * n..(k + 1) * n]);
-            }
-            self.aft
-                .synthesize_into(&ws.uk, |_| Complex64::new(1.0, 0.0), &mut ws.u, &mut ws.aft);
-            self.aft.synthesize_into(
-                &ws.uk,
-                |k| Complex64::new(0.0, k as f64 * omega),
-                &mut ws.du,
-                &mut ws.aft,
-            );
+            self.element_samples(e, q, ws);
             let law = e.law();
             let lin = e.linear_part();
             law.force_batch(&self.thetas, &ws.u, &ws.du, &mut ws.f);
@@ -287,13 +277,7 @@ impl<'m> HarmonicBalance<'m> {
                 e.scatter_add(ws.uk[k], &mut out[k * n..(k + 1) * n]);
             }
             if let Some(jac) = jac.as_deref_mut() {
-                law.derivatives_batch(&self.thetas, &ws.u, &ws.du, &mut ws.gu, &mut ws.gdu);
-                for &j in &act.jump_samples {
-                    let (t, u, du) = (self.thetas[j], ws.u[j], ws.du[j]);
-                    let (a0, b0) = law.derivatives(t - delta, u, du);
-                    let (a1, b1) = law.derivatives(t + delta, u, du);
-                    (ws.gu[j], ws.gdu[j]) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
-                }
+                self.derivative_samples(act, ws);
                 for (g, d) in ws.gu.iter_mut().zip(ws.gdu.iter_mut()) {
                     *g -= lin.stiffness;
                     *d -= lin.damping;
@@ -353,26 +337,8 @@ impl<'m> HarmonicBalance<'m> {
         let b = &mut ws.eval;
         for act in &self.active {
             let e = &self.model.elements()[act.index];
-            for k in 0..=h {
-                b.uk[k] = e.gather(&ws.q[k * n..(k + 1) * n]);
-            }
-            self.aft
-                .synthesize_into(&b.uk, |_| Complex64::new(1.0, 0.0), &mut b.u, &mut b.aft);
-            self.aft.synthesize_into(
-                &b.uk,
-                |k| Complex64::new(0.0, k as f64 * omega),
-                &mut b.du,
-                &mut b.aft,
-            );
-            let law = e.law();
-            law.derivatives_batch(&self.thetas, &b.u, &b.du, &mut b.gu, &mut b.gdu);
-            // Jump samples take the mean of both one-sided limits, as in `aft_into`.
-            let delta = 1e-7 * TAU / self.basis.samples() as f64;
-            for &j in &act.jump_samples {
-                let (t, u, du) = (self.thetas[j], b.u[j], b.du[j]);
-                b.gdu[j] = 0.5
-                    * (law.derivatives(t - delta, u, du).1 + law.derivatives(t + delta, u, du).1);
-            }
+            self.element_samples(e, &ws.q, b);
+            self.derivative_samples(act, b);
             let d0 = e.linear_part().damping;
             for ((f, g), du) in b.f.iter_mut().zip(&b.gdu).zip(&b.du) {
                 *f = (g - d0) * du / omega;
@@ -400,6 +366,37 @@ impl<'m> HarmonicBalance<'m> {
         self.z = DynamicStiffness::new(&basis, self.model.mass(), &self.d0, &self.k0)?;
         self.basis = basis;
         Ok(())
+    }
+
+    /// `u(θ_j)`, `u̇(θ_j)` of element `e` at the samples into `b.u`, `b.du` (its local
+    /// harmonics `U_k = w·Q_k` in `b.uk`).
+    fn element_samples(&self, e: &crate::Element, q: &[Complex64], b: &mut AftBuffers) {
+        let (n, omega) = (self.model.n_dofs(), self.basis.omega());
+        for (k, uk) in b.uk.iter_mut().enumerate() {
+            *uk = e.gather(&q[k * n..(k + 1) * n]);
+        }
+        self.aft
+            .synthesize_into(&b.uk, |_| Complex64::new(1.0, 0.0), &mut b.u, &mut b.aft);
+        self.aft.synthesize_into(
+            &b.uk,
+            |k| Complex64::new(0.0, k as f64 * omega),
+            &mut b.du,
+            &mut b.aft,
+        );
+    }
+
+    /// `∂f/∂u`, `∂f/∂u̇` at the samples into `b.gu`, `b.gdu`; a sample on a time jump takes the
+    /// mean of both one-sided limits, as the force does.
+    fn derivative_samples(&self, act: &ActiveElement, b: &mut AftBuffers) {
+        let law = self.model.elements()[act.index].law();
+        law.derivatives_batch(&self.thetas, &b.u, &b.du, &mut b.gu, &mut b.gdu);
+        let delta = 1e-7 * TAU / self.basis.samples() as f64;
+        for &j in &act.jump_samples {
+            let (t, u, du) = (self.thetas[j], b.u[j], b.du[j]);
+            let (a0, b0) = law.derivatives(t - delta, u, du);
+            let (a1, b1) = law.derivatives(t + delta, u, du);
+            (b.gu[j], b.gdu[j]) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
+        }
     }
 
     /// The real layout of the unknowns.
