@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 use hbal::compare::relative_error;
 use hbal::report::{line_plot, Axis, Series};
-use hbal::scene::{method_named, Scene};
+use hbal::scene::Scene;
 use hbal::timesim::TimeSimulation;
 use hbal::{HarmonicBalance, HarmonicBasis, Method, Solution};
 use serde_json::json;
@@ -162,8 +162,7 @@ fn main() -> ExitCode {
 fn load(path: &Path, method: Option<&str>, harmonics: Option<usize>) -> Result<Scene, Failure> {
     let mut scene = Scene::load(path)?;
     if let Some(name) = method {
-        let text = std::fs::read_to_string(path)?;
-        scene.method = method_named(&text, &scene.file, name)?;
+        scene.method = scene.method_named(name)?;
     }
     if let Some(h) = harmonics {
         let basis = HarmonicBasis::new(scene.basis.omega(), h)
@@ -358,10 +357,9 @@ fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure
     let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
     let h = scene.basis.harmonics();
     let n = scene.model.n_dofs();
-    let text = std::fs::read_to_string(path)?;
     let mut solutions = Vec::new();
     for name in hbal::scene::METHODS {
-        let method: Method = method_named(&text, &scene.file, name)?;
+        let method: Method = scene.method_named(name)?;
         let mut ws = hb.workspace();
         let start = Instant::now();
         let sol = method.solve(&hb, None, &mut ws)?;

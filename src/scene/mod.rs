@@ -145,6 +145,7 @@ pub struct Scene {
     pub speed_unit: &'static str,
     /// Fundamental Ω (rad/s) per unit of speed (includes `order`).
     pub omega_per_speed: f64,
+    solver: SolverSpec,
 }
 
 /// Names of the solver methods.
@@ -486,6 +487,7 @@ impl SceneFile {
             method,
             speed_unit,
             omega_per_speed: per_unit * f.order,
+            solver: self.solver,
         })
     }
 }
@@ -596,49 +598,38 @@ pub fn known_types() -> String {
     "linear_spring, mesh_stiffness, backlash, cubic_spring".to_string()
 }
 
-/// Re-reads a scene's solver settings with another method name (for `--method`).
-pub fn method_named(scene_text: &str, file: &str, name: &str) -> Result<Method, SceneError> {
-    let value: Value = if is_json(file) {
-        serde_json::from_str(scene_text).unwrap_or(Value::Null)
-    } else {
-        toml::from_str::<toml::Value>(scene_text)
-            .ok()
-            .and_then(|v| serde_json::to_value(v).ok())
-            .unwrap_or(Value::Null)
-    };
-    let spec: SolverSpec = value
-        .get("solver")
-        .cloned()
-        .and_then(|v| serde_json::from_value(v).ok())
-        .unwrap_or_default();
-    let spec = SolverSpec {
-        method: None,
-        ..spec
-    };
-    // Options meaningless for the chosen method (γ for Newton) are ignored.
-    let spec = match name {
-        "newton" | "broyden" => SolverSpec {
-            gamma: None,
-            depth: None,
-            ..spec
-        },
-        "fixed_point" => SolverSpec {
-            depth: None,
-            ..spec
-        },
-        _ => spec,
-    };
-    spec.method(Some(name))
-        .map_err(|(path, message)| SceneError {
-            file: file.to_string(),
-            position: None,
-            path: Some(if name_is_known(name) {
-                path
-            } else {
-                "--method".into()
-            }),
-            message,
-        })
+impl Scene {
+    /// The scene's solver settings applied to another method (for `--method` and `compare`);
+    /// options meaningless for that method (γ for Newton) are ignored.
+    pub fn method_named(&self, name: &str) -> Result<Method, SceneError> {
+        let spec = SolverSpec {
+            method: None,
+            ..self.solver.clone()
+        };
+        let spec = match name {
+            "newton" | "broyden" => SolverSpec {
+                gamma: None,
+                depth: None,
+                ..spec
+            },
+            "fixed_point" => SolverSpec {
+                depth: None,
+                ..spec
+            },
+            _ => spec,
+        };
+        spec.method(Some(name))
+            .map_err(|(path, message)| SceneError {
+                file: self.file.clone(),
+                position: None,
+                path: Some(if name_is_known(name) {
+                    path
+                } else {
+                    "--method".into()
+                }),
+                message,
+            })
+    }
 }
 
 fn name_is_known(name: &str) -> bool {
