@@ -5,12 +5,13 @@
 //!
 //! Run: `cargo run --release --example accuracy [-- --out DIR]`
 
+mod common;
+
 use hbal::catalog::{GearBacklash, TwoShaft};
 use hbal::compare::relative_error;
 use hbal::report::{line_plot, median_time, Axis, Series};
 use hbal::timesim::TimeSimulation;
 use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
-use std::path::PathBuf;
 use std::time::Duration;
 
 /// A case: file stem, title, model, fundamental, initial state of the time integration.
@@ -26,14 +27,7 @@ type Case = (
 const H_COMPARE: usize = 32;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().collect();
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1))
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("out"));
-    std::fs::create_dir_all(&out)?;
+    let out = common::out_dir()?;
     let shaft = TwoShaft::new(6000.0);
     let cases: Vec<Case> = vec![
         (

@@ -3,21 +3,15 @@
 //!
 //! Run: `cargo run --release --example convergence [-- --out DIR]`
 
+mod common;
+
 use hbal::catalog::{Duffing, GearBacklash, TwoShaft};
 use hbal::report::{line_plot, median_time, Axis, Series};
 use hbal::{Anderson, Broyden, FixedPoint, HarmonicBalance, HarmonicBasis, Method, Model, Newton};
-use std::path::PathBuf;
 use std::time::Duration;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().collect();
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1))
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("out"));
-    std::fs::create_dir_all(&out)?;
+    let out = common::out_dir()?;
     let two_shaft = TwoShaft::new(6000.0);
     let cases: Vec<(&str, &str, Model, f64, usize)> = vec![
         (

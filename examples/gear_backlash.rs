@@ -7,13 +7,14 @@
 //!
 //! Run: `cargo run --release --example gear_backlash [-- --out DIR]`
 
+mod common;
+
 use hbal::catalog::{GearBacklash, TwoShaft};
 use hbal::compare::relative_error;
 use hbal::continuation::{Branch, Continuation};
 use hbal::report::{branch_csv, branch_plot};
 use hbal::timesim::TimeSimulation;
 use hbal::{HarmonicBalance, HarmonicBasis, Newton};
-use std::path::PathBuf;
 use std::time::Instant;
 
 const H: usize = 32;
@@ -42,14 +43,7 @@ fn regime(branch: &Branch, i: usize, b: f64) -> &'static str {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().collect();
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1))
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("out"));
-    std::fs::create_dir_all(&out)?;
+    let out = common::out_dir()?;
     let pair = GearBacklash::default();
     let model = pair.model()?;
 

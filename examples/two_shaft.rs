@@ -5,13 +5,14 @@
 //!
 //! The model's fundamental is the mesh frequency 4Ω (harmonic k = shaft order 4k).
 
+mod common;
+
 use hbal::catalog::TwoShaft;
 use hbal::compare::relative_error;
 use hbal::report::{line_plot, median_time, Axis, Series};
 use hbal::timesim::{TimeResponse, TimeSimulation};
 use hbal::{Anderson, FixedPoint, HarmonicBalance, HarmonicBasis, Method, Solution, Termination};
 use std::f64::consts::TAU;
-use std::path::PathBuf;
 use std::time::Duration;
 
 /// Harmonics of the mesh frequency kept by the HB solver in table 1 (shaft orders up to 128).
@@ -20,14 +21,7 @@ const H: usize = 32;
 const H_COMPARE: usize = 32;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().collect();
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1))
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("out"));
-    std::fs::create_dir_all(&out)?;
+    let out = common::out_dir()?;
     let budget = Duration::from_millis(200);
 
     println!("Two-shaft model, H = {H} mesh harmonics (N = {}), fixed point with gamma = 0 (the paper's run).", HarmonicBasis::new(1.0, H)?.samples());
