@@ -1,0 +1,23 @@
+//! `hbal check`: validate a scene (parse it and build its harmonic-balance system) without
+//! solving, and print a one-line summary.
+
+use super::{load, Failure};
+use anyhow::Context;
+use hbal::HarmonicBalance;
+use std::path::Path;
+
+pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
+    let scene = load(path, None, None)?;
+    HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
+    say!(
+        "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s, H = {}, N = {}, solver {})",
+        scene.file,
+        scene.model.n_dofs(),
+        scene.model.elements().len(),
+        scene.basis.omega(),
+        scene.basis.harmonics(),
+        scene.basis.samples(),
+        scene.method.name()
+    );
+    Ok(0)
+}

@@ -1,0 +1,120 @@
+//! `hbal compare`: run every solver and the time-domain reference on one scene, and print a
+//! table (or one JSON object) of results, timings and errors against the time domain.
+
+use super::{load, Failure};
+use anyhow::Context;
+use hbal::compare::relative_error;
+use hbal::report::{line_plot, Axis, Series};
+use hbal::timesim::TimeSimulation;
+use hbal::{HarmonicBalance, Method};
+use serde_json::json;
+use std::path::Path;
+use std::time::Instant;
+
+pub(crate) fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure> {
+    let scene = load(path, None, None)?;
+    let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
+    let h = scene.basis.harmonics();
+    let n = scene.model.n_dofs();
+    let mut solutions = Vec::new();
+    for name in hbal::scene::METHODS {
+        let method: Method = scene.method_named(name)?;
+        let mut ws = hb.workspace();
+        let start = Instant::now();
+        let sol = method.solve(&hb, None, &mut ws)?;
+        solutions.push((name, start.elapsed().as_secs_f64(), sol));
+    }
+    // The time-domain reference starts on the first converged HB orbit (from rest if none):
+    // a gear pair with backlash can have coexisting orbits, and a run from rest may find
+    // another one. Its error then measures the HB orbit, and grows if that orbit is unstable.
+    let start_state = solutions
+        .iter()
+        .find(|s| s.2.is_converged())
+        .map(|(_, _, sol)| {
+            let q = (0..n).map(|i| sol.displacement(i, 0.0)).collect::<Vec<_>>();
+            let v = (0..n).map(|i| sol.velocity(i, 0.0)).collect::<Vec<_>>();
+            (q, v)
+        });
+    let from_orbit = start_state.is_some();
+    let td = TimeSimulation {
+        rtol: 1e-10,
+        steady_tolerance: 1e-8,
+        samples: (4 * h + 4).next_power_of_two().max(1024),
+        initial: start_state,
+        ..TimeSimulation::default()
+    }
+    .run(&scene.model, scene.basis.omega())
+    .with_context(|| format!("{}: time-domain reference", scene.file))?;
+    let mut rows = Vec::new();
+    let mut histories = Vec::new();
+    let mut any_converged = false;
+    for (name, seconds, sol) in &solutions {
+        let error = relative_error(sol.harmonics(), &td.harmonics, n, h);
+        any_converged |= sol.is_converged();
+        histories.push(Series::line(
+            *name,
+            sol.history
+                .iter()
+                .enumerate()
+                .map(|(i, r)| (i as f64, *r))
+                .collect(),
+        ));
+        rows.push(json!({
+            "method": name,
+            "converged": sol.is_converged(),
+            "termination": sol.termination.to_string(),
+            "iterations": sol.stats.iterations,
+            "residual": sol.residual(),
+            "solve_seconds": seconds,
+            "error_vs_time_domain": error,
+        }));
+    }
+    let td_json = json!({
+        "started_on_hb_orbit": from_orbit,
+        "converged": td.converged,
+        "stop": format!("{:?}", td.stop),
+        "periods": td.periods,
+        "steps": td.steps,
+        "seconds": td.wall_time.as_secs_f64(),
+    });
+    if as_json {
+        say!(
+            "{}",
+            json!({"scene": scene.file, "time_domain": td_json, "methods": rows})
+        );
+    } else {
+        say!(
+            "{}: time domain (from {}) {:?} after {} periods, {} steps, {:.3} ms",
+            scene.file,
+            if from_orbit { "the HB orbit" } else { "rest" },
+            td.stop,
+            td.periods,
+            td.steps,
+            td.wall_time.as_secs_f64() * 1e3
+        );
+        say!("| method | result | iterations | wall | error vs time domain |");
+        say!("|---|---|---:|---:|---:|");
+        for r in &rows {
+            say!(
+                "| {} | {} | {} | {:.3} ms | {:.2e} |",
+                r["method"].as_str().unwrap_or(""),
+                r["termination"].as_str().unwrap_or(""),
+                r["iterations"],
+                r["solve_seconds"].as_f64().unwrap_or(f64::NAN) * 1e3,
+                r["error_vs_time_domain"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+    }
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir)?;
+        line_plot(
+            &dir.join("residual_histories.svg"),
+            "Residual histories",
+            &Axis::linear("iteration"),
+            &Axis::log("relative residual"),
+            &histories,
+        )
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    }
+    Ok(if any_converged { 0 } else { 1 })
+}

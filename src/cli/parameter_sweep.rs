@@ -1,0 +1,109 @@
+//! `hbal sweep --parameter <field>`: a warm-started sweep of one numeric scene field over
+//! `--points` values (does not follow folds), with stability, and optionally branch.csv and
+//! one parameter-response SVG per DOF.
+
+use super::Failure;
+use anyhow::Context;
+use hbal::scene::Scene;
+use serde_json::json;
+use std::path::Path;
+use std::time::Instant;
+
+pub(crate) fn parameter_sweep(
+    path: &Path,
+    name: &str,
+    from: f64,
+    to: f64,
+    points: usize,
+    as_json: bool,
+    out: Option<&Path>,
+) -> Result<u8, Failure> {
+    use hbal::continuation::{parameter_sweep, BranchStop};
+    let file = path.display().to_string();
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read the file"))?;
+    let doc = Scene::parse_value(&text, &file)?;
+    if !(from.is_finite() && to.is_finite()) || points < 2 {
+        return Err(anyhow::anyhow!("--from and --to must be finite and --points >= 2").into());
+    }
+    // Check the path and the scene once before sweeping.
+    let mut probe = doc.clone();
+    hbal::scene::set_parameter(&mut probe, name, from)
+        .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
+    Scene::from_value(probe, &file)?;
+    let values: Vec<f64> = (0..points)
+        .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
+        .collect();
+    let bar = indicatif::ProgressBar::new(points as u64);
+    if as_json {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let start = Instant::now();
+    let branch = parameter_sweep(
+        &values,
+        |p| {
+            let mut d = doc.clone();
+            hbal::scene::set_parameter(&mut d, name, p)
+                .map_err(|e| hbal::Error::Solver { reason: e })?;
+            let scene = Scene::from_value(d, &file).map_err(|e| hbal::Error::Solver {
+                reason: e.to_string(),
+            })?;
+            Ok((scene.model, scene.basis))
+        },
+        None,
+        |f| bar.set_position((f * points as f64) as u64),
+    )
+    .with_context(|| file.clone())?;
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    if as_json {
+        let pts: Vec<_> = branch
+            .points
+            .iter()
+            .map(|p| json!({"parameter": p.parameter, "stable": p.stable(), "bifurcation": p.bifurcation.map(|b| format!("{b:?}")), "max_abs": p.max_abs}))
+            .collect();
+        say!(
+            "{}",
+            json!({"scene": file, "parameter": name, "stop": branch.stop.to_string(), "reached": branch.stop == BranchStop::Reached, "seconds": seconds, "dofs": branch.dofs, "points": pts})
+        );
+    } else {
+        say!(
+            "{file}: {} values of {name} from {from} to {to} in {:.1} ms: {}",
+            branch.points.len(),
+            seconds * 1e3,
+            branch.stop
+        );
+        for p in branch.points.iter().filter(|p| p.bifurcation.is_some()) {
+            say!(
+                "  stability change ({:?}) at {name} = {}",
+                p.bifurcation.unwrap_or(hbal::stability::Bifurcation::Fold),
+                p.parameter
+            );
+        }
+    }
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir)?;
+        std::fs::write(
+            dir.join("branch.csv"),
+            hbal::report::branch_csv(&branch, name, |p| p),
+        )?;
+        if branch.points.len() >= 2 {
+            for (i, dof) in branch.dofs.iter().enumerate() {
+                hbal::report::branch_plot(
+                    &dir.join(format!("parameter_response_{dof}.svg")),
+                    &branch,
+                    i,
+                    &format!("Response of {dof} against {name}"),
+                    name,
+                    |p| p,
+                )
+                .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+            }
+        }
+    }
+    Ok(if branch.stop == BranchStop::Reached {
+        0
+    } else {
+        1
+    })
+}
