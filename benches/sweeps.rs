@@ -53,7 +53,7 @@ fn gear_backlash_curve(c: &mut Criterion) {
         })
     });
     let cont = Continuation {
-        floquet_steps: Some(0),
+        stability: None,
         ..Continuation::default()
     };
     g.bench_function("duffing_H7_through_both_folds_no_stability", |b| {

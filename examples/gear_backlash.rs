@@ -135,7 +135,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         continue;
                     }
                     let d = relative_error(sol.harmonics(), &td.harmonics, 1, H);
-                    let stable = hbal::stability::floquet(&model, &sol, 256)?.is_stable();
+                    let stable = hbal::stability::floquet(&model, &sol)?.is_stable();
                     if best.is_none_or(|b| d < b.0) {
                         best = Some((d, stable));
                     }

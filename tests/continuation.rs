@@ -61,7 +61,7 @@ fn fold_locations_converge_with_harmonics() {
     let mut upper = Vec::new();
     for h in [1usize, 3, 5, 7, 9] {
         let branch = Continuation {
-            floquet_steps: Some(0),
+            stability: None,
             max_step: 0.1,
             ..Continuation::default()
         }

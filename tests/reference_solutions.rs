@@ -154,7 +154,8 @@ fn time_domain_reports_a_stall() {
     assert!(td.periods < 2000, "{}", td.periods);
 }
 
-/// Floquet multipliers from the HB solution's monodromy matrix against the shared references.
+/// Floquet multipliers (shooting-polished monodromy) against the shared references: 1e-6
+/// absolute in the moduli.
 #[test]
 fn floquet_multipliers_match_references() {
     use hbal::stability::floquet;
@@ -181,16 +182,19 @@ fn floquet_multipliers_match_references() {
         let hb = HarmonicBalance::new(&model, HarmonicBasis::new(r.omega, h).unwrap()).unwrap();
         let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
         assert!(sol.is_converged(), "{file}");
-        let f = floquet(&model, &sol, 2048).unwrap();
+        let f = floquet(&model, &sol).unwrap();
         let expected: Vec<f64> = r.json["floquet_multipliers_abs"]
             .as_array()
             .unwrap()
             .iter()
             .map(|v| v.as_f64().unwrap())
             .collect();
+        assert_eq!(f.multipliers.len(), expected.len(), "{file}");
+        assert!(f.polished, "{file}: shooting did not converge");
         for (got, want) in f.multipliers.iter().zip(&expected) {
+            eprintln!("{file}: |μ| {:.12e} vs {want:.12e}", got.norm());
             assert!(
-                (got.norm() - want).abs() < 2e-3 * want.max(0.1),
+                (got.norm() - want).abs() < 1e-6,
                 "{file}: |μ| {} vs {want}",
                 got.norm()
             );

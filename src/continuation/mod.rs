@@ -20,7 +20,7 @@ use crate::model::Model;
 use crate::residual::{HarmonicBalance, Workspace};
 use crate::solve::lu;
 use crate::solve::Newton;
-use crate::stability::{floquet, Bifurcation, Floquet};
+use crate::stability::{Bifurcation, Floquet, FloquetOptions};
 use crate::HarmonicBasis;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -156,8 +156,9 @@ pub struct Continuation {
     pub tolerance: f64,
     /// Corrector iterations before the step is halved. Default 8.
     pub max_corrector: usize,
-    /// Floquet steps per period (`Some(0)`: no stability). Default: 4H, at least 64.
-    pub floquet_steps: Option<usize>,
+    /// How to compute the stability of every point (`None`: no stability). Default: the
+    /// default [`FloquetOptions`].
+    pub stability: Option<FloquetOptions>,
 }
 
 impl Default for Continuation {
@@ -169,7 +170,7 @@ impl Default for Continuation {
             max_points: 10_000,
             tolerance: 1e-10,
             max_corrector: 8,
-            floquet_steps: None,
+            stability: Some(FloquetOptions::default()),
         }
     }
 }
@@ -436,13 +437,9 @@ impl Continuation {
             stats: Default::default(),
             wall_time: Default::default(),
         };
-        let steps = self
-            .floquet_steps
-            .unwrap_or((4 * hb.basis().harmonics()).max(64));
-        let floquet = if steps > 0 {
-            Some(floquet(model, &sol, steps.max(16))?)
-        } else {
-            None
+        let floquet = match &self.stability {
+            Some(options) => Some(options.compute(model, &sol)?),
+            None => None,
         };
         let prev = branch.points.last().and_then(|p| p.floquet.clone());
         let prev_stable = prev.as_ref().map(|f| f.is_stable());
@@ -471,17 +468,17 @@ impl Continuation {
 
 /// A warm-started sweep over any parameter: `build(p)` gives the model and basis at `p`; each
 /// point starts Newton from the previous one. It stops with [`BranchStop::NotConverged`] where
-/// Newton fails (it does not follow folds). Floquet steps as in [`Continuation`].
+/// Newton fails (it does not follow folds). Stability as in [`Continuation`].
 pub fn parameter_sweep(
     values: &[f64],
     mut build: impl FnMut(f64) -> Result<(Model, HarmonicBasis)>,
-    floquet_steps: Option<usize>,
+    stability: Option<FloquetOptions>,
     mut progress: impl FnMut(f64),
 ) -> Result<Branch> {
     let mut branch: Option<Branch> = None;
     let mut previous: Option<Vec<Complex64>> = None;
     let cont = Continuation {
-        floquet_steps,
+        stability,
         ..Continuation::default()
     };
     for (i, &p) in values.iter().enumerate() {

@@ -159,6 +159,14 @@ impl ForceLaw for Backlash {
             offset,
         }
     }
+    fn kinks(&self) -> Vec<f64> {
+        let b = self.half_backlash;
+        if b > 0.0 {
+            vec![-b, b]
+        } else {
+            vec![0.0]
+        }
+    }
     fn time_breakpoints(&self) -> Vec<f64> {
         jump_angles(&self.stiffness.jumps(), self.teeth, self.phase)
     }

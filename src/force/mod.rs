@@ -145,6 +145,16 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
         Vec::new()
     }
 
+    /// Values of `u` where the law is not smooth (a contact edge): its derivatives, and
+    /// possibly the force itself (contact damping), jump when `u` crosses one of them.
+    ///
+    /// The Floquet analysis ([`crate::stability`]) locates every crossing of the orbit, restarts
+    /// its integrator there and applies the saltation matrix of a force jump; a law that
+    /// declares no kinks is treated as smooth. Default: none.
+    fn kinks(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
     /// `true` if the force is exactly `k0 u + d0 u̇` at all times: the element then lives
     /// entirely in `K0`, `D0` and costs nothing in the time domain. Default: `false`.
     fn is_linear_time_invariant(&self) -> bool {

@@ -338,7 +338,7 @@ impl TimeSimulation {
 }
 
 /// Segment bounds in θ over one period: 0, every declared time jump, 2π.
-fn segment_bounds(model: &Model) -> Vec<f64> {
+pub(crate) fn segment_bounds(model: &Model) -> Vec<f64> {
     let mut b: Vec<f64> = model
         .elements()
         .iter()

@@ -1,0 +1,460 @@
+//! The flow of the equations of motion and of their variational equation over one period,
+//! piece by piece.
+//!
+//! State `y = (q, q̇, Φ̃)`: the physical state and the scaled monodromy matrix
+//! `Φ̃ = S⁻¹ Φ S`, `S = diag(s_q I, s_v I)`, whose entries are of order one. With the
+//! time-varying linearisation `K(t) = K + Σ_e k_e(t) w_e w_eᵀ`, `D(t) = D + Σ_e d_e(t) w_e w_eᵀ`
+//! (`k_e = ∂f_e/∂u`, `d_e = ∂f_e/∂u̇` along the orbit) and `ω_s = s_v / s_q`,
+//!
+//! `Φ̃' = [[0, ω_s I], [-M⁻¹K(t)/ω_s, -M⁻¹D(t)]] Φ̃`.
+//!
+//! **Pieces.** The right-hand side is smooth between the law's declared time jumps
+//! ([`ForceLaw::time_breakpoints`](crate::force::ForceLaw::time_breakpoints)) and kinks
+//! ([`ForceLaw::kinks`](crate::force::ForceLaw::kinks)). Inside a piece every law is evaluated
+//! on its current side of each kink (continued linearly from the one-sided limit where a Runge–
+//! Kutta stage strays across), so the integrator sees a smooth field. A crossing of a kink is
+//! located to the integrator's accuracy by re-stepping to the crossing time (Newton on
+//! `u(t*) = kink`); the piece then changes, and a force that jumps there (contact damping) is
+//! accounted for by the saltation matrix
+//! `S = I + (F⁺ - F⁻) ∇gᵀ / (∇g·F⁻)`, `g = w·q - kink`, which for `F = (q̇, M⁻¹(...))` adds
+//! `-M⁻¹ w Δf (wᵀ δq) / u̇` to `δq̇`. A time jump needs no saltation (its switching surface does
+//! not depend on the state).
+
+use super::dopri::{hermite, step_factor, Stepper};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use nalgebra::DMatrix;
+
+/// Where each element is relative to its kinks: `side[e] = j` means
+/// `kinks[e][j-1] <= u < kinks[e][j]` (open at the ends).
+struct Pieces {
+    kinks: Vec<Vec<f64>>,
+    side: Vec<usize>,
+}
+
+impl Pieces {
+    fn interval(&self, e: usize) -> (f64, f64) {
+        let k = &self.kinks[e];
+        let j = self.side[e];
+        let lo = if j == 0 { f64::NEG_INFINITY } else { k[j - 1] };
+        let hi = k.get(j).copied().unwrap_or(f64::INFINITY);
+        (lo, hi)
+    }
+}
+
+/// The integration options and counters.
+pub(crate) struct FlowOptions {
+    pub rtol: f64,
+    pub h_max: f64,
+    pub max_steps: usize,
+}
+
+/// The flow over one period.
+pub(crate) struct Flow<'m> {
+    model: &'m Model,
+    n: usize,
+    m_inv: DMatrix<f64>,
+    omega: f64,
+    /// θ bounds of the time pieces over one period.
+    bounds: Vec<f64>,
+    /// Current time piece: (t_a, θ_a, θ_lo, θ_hi).
+    segment: (f64, f64, f64, f64),
+    pieces: Pieces,
+    scale_q: f64,
+    omega_s: f64,
+    atol: Vec<f64>,
+    // Buffers.
+    acc: Vec<f64>,
+    kt: DMatrix<f64>,
+    dt: DMatrix<f64>,
+    bk: DMatrix<f64>,
+    cd: DMatrix<f64>,
+    /// Steps taken (accepted and rejected).
+    pub steps: usize,
+}
+
+impl<'m> Flow<'m> {
+    /// The flow of `model` at fundamental `omega`, with state scales `s_q`, `s_v`.
+    pub(crate) fn new(
+        model: &'m Model,
+        omega: f64,
+        scale_q: f64,
+        scale_v: f64,
+        rtol: f64,
+    ) -> Result<Self> {
+        let n = model.n_dofs();
+        let m_inv = model
+            .mass()
+            .clone()
+            .cholesky()
+            .ok_or_else(|| Error::MassNotPositiveDefinite {
+                reason: "Cholesky factorisation failed".into(),
+            })?
+            .inverse();
+        let kinks = model
+            .elements()
+            .iter()
+            .map(|e| {
+                let mut k: Vec<f64> = e
+                    .law()
+                    .kinks()
+                    .into_iter()
+                    .filter(|v| v.is_finite())
+                    .collect();
+                k.sort_by(f64::total_cmp);
+                k.dedup();
+                k
+            })
+            .collect::<Vec<_>>();
+        let side = vec![0; kinks.len()];
+        let len = 2 * n + 4 * n * n;
+        let mut atol = vec![rtol; len];
+        atol[..n].iter_mut().for_each(|a| *a = rtol * scale_q);
+        atol[n..2 * n].iter_mut().for_each(|a| *a = rtol * scale_v);
+        Ok(Self {
+            model,
+            n,
+            m_inv,
+            omega,
+            bounds: crate::timesim::segment_bounds(model),
+            segment: (0.0, 0.0, 0.0, std::f64::consts::TAU),
+            pieces: Pieces { kinks, side },
+            scale_q,
+            omega_s: scale_v / scale_q,
+            atol,
+            acc: vec![0.0; n],
+            kt: DMatrix::zeros(n, n),
+            dt: DMatrix::zeros(n, n),
+            bk: DMatrix::zeros(n, n),
+            cd: DMatrix::zeros(n, n),
+            steps: 0,
+        })
+    }
+
+    /// Length of the augmented state.
+    pub(crate) fn len(&self) -> usize {
+        2 * self.n + 4 * self.n * self.n
+    }
+
+    fn enter_segment(&mut self, t_a: f64, theta_a: f64, theta_b: f64) {
+        let delta = 1e-9 * (theta_b - theta_a);
+        self.segment = (t_a, theta_a, theta_a + delta, theta_b - delta);
+    }
+
+    /// Force and derivatives of element `e` on its current piece at `(θ, u, u̇)`.
+    fn element_law(&self, e: usize, theta: f64, u: f64, du: f64) -> (f64, f64, f64) {
+        let law = self.model.elements()[e].law();
+        let (lo, hi) = self.pieces.interval(e);
+        if u > lo && u < hi {
+            let f = law.force(theta, u, du);
+            let (k, d) = law.derivatives(theta, u, du);
+            return (f, k, d);
+        }
+        // Continue the piece linearly from just inside its edge.
+        let edge = if u <= lo { lo } else { hi };
+        let inside = nudge(edge, if u <= lo { 1.0 } else { -1.0 });
+        let f = law.force(theta, inside, du);
+        let (k, d) = law.derivatives(theta, inside, du);
+        (f + k * (u - inside), k, d)
+    }
+
+    /// The right-hand side of the augmented state.
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let n = self.n;
+        let (ta, tha, lo, hi) = self.segment;
+        let theta = (tha + self.omega * (t - ta)).clamp(lo, hi);
+        let (q, rest) = y.split_at(n);
+        let (v, phi) = rest.split_at(n);
+        self.acc.fill(0.0);
+        self.model.load_into(theta, &mut self.acc);
+        let (d, k) = (
+            self.model.structural_damping(),
+            self.model.structural_stiffness(),
+        );
+        self.kt.copy_from(k);
+        self.dt.copy_from(d);
+        for i in 0..n {
+            let mut s = 0.0;
+            for j in 0..n {
+                s += d[(i, j)] * v[j] + k[(i, j)] * q[j];
+            }
+            self.acc[i] -= s;
+        }
+        for (ei, e) in self.model.elements().iter().enumerate() {
+            let (f, ke, de) = self.element_law(ei, theta, e.gather(q), e.gather(v));
+            e.scatter_add(-f, &mut self.acc);
+            e.add_outer(&mut self.kt, ke);
+            e.add_outer(&mut self.dt, de);
+        }
+        dy[..n].copy_from_slice(v);
+        for i in 0..n {
+            dy[n + i] = (0..n).map(|j| self.m_inv[(i, j)] * self.acc[j]).sum();
+        }
+        self.m_inv.mul_to(&self.kt, &mut self.bk);
+        self.bk /= self.omega_s;
+        self.m_inv.mul_to(&self.dt, &mut self.cd);
+        let s2 = 2 * n;
+        let dphi = &mut dy[s2..];
+        for c in 0..s2 {
+            let col = &phi[c * s2..(c + 1) * s2];
+            let (top, bot) = col.split_at(n);
+            let out = &mut dphi[c * s2..(c + 1) * s2];
+            for i in 0..n {
+                out[i] = self.omega_s * bot[i];
+                let mut s = 0.0;
+                for j in 0..n {
+                    s += self.bk[(i, j)] * top[j] + self.cd[(i, j)] * bot[j];
+                }
+                out[n + i] = -s;
+            }
+        }
+    }
+
+    /// Sets each element's piece from the state `(q, q̇)` at the start.
+    fn init_pieces(&mut self, y: &[f64]) {
+        let n = self.n;
+        for (ei, e) in self.model.elements().iter().enumerate() {
+            let (u, du) = (e.gather(&y[..n]), e.gather(&y[n..2 * n]));
+            let k = &self.pieces.kinks[ei];
+            // On a kink, the side it is moving to.
+            self.pieces.side[ei] = k
+                .iter()
+                .filter(|&&kv| kv < u || (kv == u && du > 0.0))
+                .count();
+        }
+    }
+
+    /// The first kink crossing inside the last step `(t, y) → (t + h, y_new)`: `(fraction of
+    /// the step, element, upwards?)` from the cubic Hermite interpolant of each `u`.
+    fn first_crossing(
+        &self,
+        y: &[f64],
+        f0: &[f64],
+        y1: &[f64],
+        f1: &[f64],
+        h: f64,
+    ) -> Option<(f64, usize, bool)> {
+        let n = self.n;
+        let mut best: Option<(f64, usize, bool)> = None;
+        for (ei, e) in self.model.elements().iter().enumerate() {
+            let (lo, hi) = self.pieces.interval(ei);
+            if lo == f64::NEG_INFINITY && hi == f64::INFINITY {
+                continue;
+            }
+            let (u0, u1) = (e.gather(&y[..n]), e.gather(&y1[..n]));
+            let (du0, du1) = (e.gather(&f0[..n]), e.gather(&f1[..n]));
+            let tol = 1e-13 * (self.scale_q + lo.abs().min(hi.abs()).min(1e300));
+            let outside = |u: f64| -> Option<bool> {
+                if u >= hi + tol {
+                    Some(true)
+                } else if u <= lo - tol {
+                    Some(false)
+                } else {
+                    None
+                }
+            };
+            const PROBES: usize = 8;
+            let mut prev_s = 0.0;
+            for p in 1..=PROBES {
+                let s = p as f64 / PROBES as f64;
+                let u = if p == PROBES {
+                    u1
+                } else {
+                    hermite(u0, u1, du0, du1, h, s)
+                };
+                if let Some(up) = outside(u) {
+                    // Bisection on the interpolant inside [prev_s, s].
+                    let edge = if up { hi } else { lo };
+                    let (mut a, mut b) = (prev_s, s);
+                    for _ in 0..50 {
+                        let mid = 0.5 * (a + b);
+                        let um = hermite(u0, u1, du0, du1, h, mid);
+                        if (um - edge) * (if up { 1.0 } else { -1.0 }) >= 0.0 {
+                            b = mid;
+                        } else {
+                            a = mid;
+                        }
+                    }
+                    if best.is_none_or(|(sb, _, _)| b < sb) {
+                        best = Some((b, ei, up));
+                    }
+                    break;
+                }
+                prev_s = s;
+            }
+        }
+        best
+    }
+
+    /// Integrates `y` over one period `[0, T]`. `y` must hold `(q, q̇)` and `Φ̃(0)`.
+    pub(crate) fn period(
+        &mut self,
+        y: &mut [f64],
+        opts: &FlowOptions,
+        stepper: &mut Stepper,
+    ) -> Result<()> {
+        self.init_pieces(y);
+        let bounds = self.bounds.clone();
+        let atol = std::mem::take(&mut self.atol);
+        let result = self.period_with(y, opts, stepper, &bounds, &atol);
+        self.atol = atol;
+        result
+    }
+
+    fn period_with(
+        &mut self,
+        y: &mut [f64],
+        opts: &FlowOptions,
+        stepper: &mut Stepper,
+        bounds: &[f64],
+        atol: &[f64],
+    ) -> Result<()> {
+        let n = self.n;
+        let omega = self.omega;
+        let mut h = opts.h_max.min(0.01 * std::f64::consts::TAU / omega);
+        let (mut f0, mut ytmp) = (vec![0.0; y.len()], vec![0.0; y.len()]);
+        for w in bounds.windows(2) {
+            let (ta, tb) = (w[0] / omega, w[1] / omega);
+            self.enter_segment(ta, w[0], w[1]);
+            let mut t = ta;
+            let mut fresh = true;
+            while tb - t > 1e-14 * tb.abs().max(1.0 / omega) {
+                if self.steps >= opts.max_steps {
+                    return Err(Error::Solver {
+                        reason: format!(
+                            "Floquet integration needed more than {} steps in one period",
+                            opts.max_steps
+                        ),
+                    });
+                }
+                if fresh {
+                    self.rhs(t, y, stepper.start_derivative());
+                    fresh = false;
+                }
+                h = h.min(opts.h_max);
+                let last = tb - t <= h * 1.000001;
+                let hs = if last { tb - t } else { h };
+                self.steps += 1;
+                f0.copy_from_slice(stepper.start_derivative());
+                let err = stepper.step(
+                    &mut |tt, yy, dd| self.rhs(tt, yy, dd),
+                    t,
+                    y,
+                    hs,
+                    opts.rtol,
+                    atol,
+                );
+                if !err.is_finite() {
+                    return Err(Error::NonFinite {
+                        what: format!("variational equation at t = {t:e}"),
+                    });
+                }
+                if err > 1.0 {
+                    h = hs * step_factor(err).min(1.0);
+                    if h < 1e-14 * (1.0 / omega) {
+                        return Err(Error::Solver {
+                            reason: format!("Floquet integration step underflow at t = {t:e}"),
+                        });
+                    }
+                    continue;
+                }
+                let crossing = self.first_crossing(y, &f0, &stepper.y_new, &stepper.f_new, hs);
+                let Some((s, e, up)) = crossing else {
+                    stepper.advance(y);
+                    t += hs;
+                    if last {
+                        t = tb;
+                    }
+                    h = hs.max(h.min(hs)) * step_factor(err);
+                    if last {
+                        h = h.max(hs);
+                    }
+                    continue;
+                };
+                // Re-step to the crossing and refine it by Newton on u(t*) = kink.
+                let edge = {
+                    let (lo, hi) = self.pieces.interval(e);
+                    if up {
+                        hi
+                    } else {
+                        lo
+                    }
+                };
+                let el = &self.model.elements()[e];
+                let mut hc = s * hs;
+                ytmp.copy_from_slice(y);
+                stepper.start_derivative().copy_from_slice(&f0);
+                for _ in 0..8 {
+                    self.steps += 1;
+                    stepper.step(
+                        &mut |tt, yy, dd| self.rhs(tt, yy, dd),
+                        t,
+                        &ytmp,
+                        hc,
+                        opts.rtol,
+                        atol,
+                    );
+                    let u = el.gather(&stepper.y_new[..n]);
+                    let du = el.gather(&stepper.y_new[n..2 * n]);
+                    let g = u - edge;
+                    if g.abs() <= 1e-14 * (edge.abs() + self.scale_q) || du == 0.0 {
+                        break;
+                    }
+                    hc = (hc - g / du).clamp(1e-3 * hc, hs);
+                    stepper.start_derivative().copy_from_slice(&f0);
+                }
+                stepper.advance(y);
+                t += hc;
+                self.cross(e, up, t, y);
+                fresh = true;
+            }
+        }
+        Ok(())
+    }
+
+    /// Moves element `e` across its kink at time `t` and applies the saltation matrix of a
+    /// force jump to `Φ̃`.
+    fn cross(&mut self, e: usize, up: bool, t: f64, y: &mut [f64]) {
+        let n = self.n;
+        let (ta, tha, lo, hi) = self.segment;
+        let theta = (tha + self.omega * (t - ta)).clamp(lo, hi);
+        let el = &self.model.elements()[e];
+        let (u, du) = (el.gather(&y[..n]), el.gather(&y[n..2 * n]));
+        let (f_before, _, _) = self.element_law(e, theta, u, du);
+        if up {
+            self.pieces.side[e] += 1;
+        } else {
+            self.pieces.side[e] -= 1;
+        }
+        let (f_after, _, _) = self.element_law(e, theta, u, du);
+        let jump = f_after - f_before;
+        let size = f_before.abs().max(f_after.abs());
+        if jump.abs() <= 1e-9 * size || du == 0.0 {
+            return;
+        }
+        // δq̇ += -M⁻¹ w Δf (wᵀ δq) / u̇, in the scaled coordinates.
+        let mut mw = vec![0.0; n];
+        for i in 0..n {
+            mw[i] = el
+                .weights()
+                .iter()
+                .map(|&(j, wj)| self.m_inv[(i, j)] * wj)
+                .sum();
+        }
+        let factor = -jump / (du * self.omega_s);
+        let s2 = 2 * n;
+        for c in 0..s2 {
+            let col = &mut y[s2 + c * s2..s2 + (c + 1) * s2];
+            let wq = el.gather(&col[..n]);
+            for i in 0..n {
+                col[n + i] += factor * mw[i] * wq;
+            }
+        }
+    }
+}
+
+/// A point just inside a kink at `x`, on the side `direction` (±1).
+fn nudge(x: f64, direction: f64) -> f64 {
+    let step = 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE);
+    x + direction * step
+}

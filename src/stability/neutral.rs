@@ -1,0 +1,111 @@
+//! Neutral modes: rigid-body motions that no stiffness, damping or element restrains.
+//!
+//! A vector `r` with `K r = 0`, `D r = 0` and `w_e·r = 0` for every element moves freely: the
+//! variational equation has the solutions `(δq, δq̇) = (r, 0)` and `(t r, r)`, so the monodromy
+//! matrix has the invariant subspace `V = span{(r, 0), (0, r)}` with the double multiplier 1
+//! (`Φ (0, r) = (T r, r)`). These multipliers are 1 by construction and say nothing about
+//! stability. In an orthonormal basis `[V W]` the monodromy matrix is block upper triangular,
+//! and the multipliers that decide stability are those of `Wᵀ Φ W`.
+
+use crate::model::Model;
+use nalgebra::DMatrix;
+
+/// Orthonormal basis (columns) of the rigid-body modes of `model`, in the DOF coordinates.
+pub(crate) fn rigid_body_modes(model: &Model) -> DMatrix<f64> {
+    let n = model.n_dofs();
+    // G = [K/|K|; D/|D|; w_eᵀ/|w_e|]; its null space is the set of free motions.
+    let mut g = DMatrix::<f64>::zeros(n, n);
+    let mut add_rows = |rows: &DMatrix<f64>| {
+        let norm = rows.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if norm > 0.0 {
+            g += rows.transpose() * rows / (norm * norm);
+        }
+    };
+    add_rows(model.structural_stiffness());
+    add_rows(model.structural_damping());
+    for e in model.elements() {
+        let mut w = DMatrix::<f64>::zeros(1, n);
+        for &(i, wi) in e.weights() {
+            w[(0, i)] += wi;
+        }
+        add_rows(&w);
+    }
+    let eig = g.symmetric_eigen();
+    let top = eig.eigenvalues.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let free: Vec<usize> = (0..n)
+        .filter(|&i| eig.eigenvalues[i].abs() <= 1e-12 * top.max(f64::MIN_POSITIVE))
+        .collect();
+    let mut r = DMatrix::zeros(n, free.len());
+    for (c, &i) in free.iter().enumerate() {
+        r.set_column(c, &eig.eigenvectors.column(i));
+    }
+    r
+}
+
+/// An orthonormal basis of the orthogonal complement of the columns of `v` (orthonormal) in
+/// `R^m`.
+pub(crate) fn complement(v: &DMatrix<f64>, m: usize) -> DMatrix<f64> {
+    if v.ncols() == 0 {
+        return DMatrix::identity(m, m);
+    }
+    let p = DMatrix::<f64>::identity(m, m) - v * v.transpose();
+    let eig = p.symmetric_eigen();
+    let keep: Vec<usize> = (0..m).filter(|&i| eig.eigenvalues[i] > 0.5).collect();
+    let mut w = DMatrix::zeros(m, keep.len());
+    for (c, &i) in keep.iter().enumerate() {
+        w.set_column(c, &eig.eigenvectors.column(i));
+    }
+    w
+}
+
+/// The state-space bases for rigid-body modes `r` (n × p): `(positions, all)` with
+/// `positions = [(r, 0)]` and `all = [(r, 0), (0, r)]`, both orthonormal in `R^{2n}`.
+pub(crate) fn state_bases(r: &DMatrix<f64>) -> (DMatrix<f64>, DMatrix<f64>) {
+    let (n, p) = r.shape();
+    let mut pos = DMatrix::zeros(2 * n, p);
+    let mut all = DMatrix::zeros(2 * n, 2 * p);
+    for c in 0..p {
+        for i in 0..n {
+            pos[(i, c)] = r[(i, c)];
+            all[(i, c)] = r[(i, c)];
+            all[(n + i, p + c)] = r[(i, c)];
+        }
+    }
+    (pos, all)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::force::LinearSpring;
+
+    #[test]
+    fn two_inertias_on_a_shaft_have_one_rigid_mode() {
+        let model = Model::builder(&["a", "b"])
+            .mass_diagonal(&[1.0, 2.0])
+            .element(
+                "shaft",
+                &[("a", 1.0), ("b", -1.0)],
+                LinearSpring::new(10.0, 0.1),
+            )
+            .build()
+            .unwrap();
+        let r = rigid_body_modes(&model);
+        assert_eq!(r.ncols(), 1);
+        assert!((r[(0, 0)] - r[(1, 0)]).abs() < 1e-12);
+        let grounded = Model::builder(&["a", "b"])
+            .mass_diagonal(&[1.0, 2.0])
+            .element(
+                "shaft",
+                &[("a", 1.0), ("b", -1.0)],
+                LinearSpring::new(10.0, 0.1),
+            )
+            .element("ground", &[("a", 1.0)], LinearSpring::new(1e-9, 0.0))
+            .build()
+            .unwrap();
+        assert_eq!(rigid_body_modes(&grounded).ncols(), 0);
+        let w = complement(&r, 2);
+        assert_eq!(w.ncols(), 1);
+        assert!((w.column(0).dot(&r.column(0))).abs() < 1e-12);
+    }
+}
