@@ -947,6 +947,14 @@ INDEX_TAIL = """
   u = b near W = 0.83; the contact-loss branch is lost near W = 0.55, not at a smooth fold since
   its multipliers stay complex there, so probably at a grazing too). The scene `examples/scenes/gear_backlash.toml`
   (W = 0.7) lies inside: it has two stable orbits and one saddle, all three stored here.
+- Gear pair, Fa = 0.3, W = 0.8: this double-sided orbit lies just below a saddle-node of its
+  branch (real multiplier 0.787 at W = 0.8, 0.862 at 0.802, 0.958 at 0.804, branch lost by
+  W = 0.806, so the fold is near W = 0.805). Stable and well converged, but a solver needs a
+  good start there. For Fa = 0.3, 0.9 <= W <= 1.6 the time integration from (1.5, 0) and
+  (2.5, 1) did not settle to a T-periodic orbit in 300 periods (subharmonic or chaotic).
+- No orbit here is close to grazing: the smallest distance of a non-crossing extremum of u to
+  +-b is 0.012 (W = 0.8 no-impact orbit), the smallest |u'| at a contact switch is 0.091 (the
+  W = 0.8 saddle).
 - Chain: `chain_backlash.toml` is the scene at W = 1.36 (change `fundamental.rad_s` for the other
   orbits). Along the symmetric branch the half-period map G = -P_{T/2} (P_T = G o G) has a real
   eigenvalue mu through -1, i.e. a full multiplier mu^2 through +1, at the stored
