@@ -202,7 +202,6 @@ class Model:
             g = np.zeros(2 * n)
             g[n:] = Minv[:, dof]
             lparts.append((g, order * self.Omega, c, s))
-        Om = self.Omega
 
         def field(t):
             A = A0
@@ -488,7 +487,7 @@ def reference_orbit(model, y_guess, extra, half=False, fd_check=True, exact=None
             multipliers(Jfd), lam12)
         conv["finite_difference_note"] = ("central differences of the period map, step 1e-6 "
                                           "* scale_i, rtol 1e-12 (limited by integration "
-                                          "noise / step, about 1e-7)")
+                                          "noise / step, up to about 2e-8)")
     liou = liouville(model)
     conv["liouville_product_of_multipliers"] = liou
     conv["liouville_relative_diff"] = float(abs(abs(np.prod(lam12)) - liou) / liou)
