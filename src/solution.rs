@@ -85,6 +85,35 @@ pub struct Solution {
 }
 
 impl Solution {
+    /// A solution made of given harmonics (a branch point, a previous result): harmonic-major
+    /// `Q[k * n + i]` with `n = dofs.len()` and `k = 0..=H` of `basis`; the termination is
+    /// [`Termination::Converged`] with the residual `residual`.
+    pub fn from_harmonics(
+        basis: HarmonicBasis,
+        dofs: Vec<String>,
+        harmonics: Vec<Complex64>,
+        residual: f64,
+    ) -> crate::Result<Self> {
+        let expected = (basis.harmonics() + 1) * dofs.len();
+        if harmonics.len() != expected {
+            return Err(crate::Error::DimensionMismatch {
+                context: "solution harmonics".into(),
+                expected: format!("{expected} (H + 1 = {} per DOF)", basis.harmonics() + 1),
+                got: format!("{}", harmonics.len()),
+            });
+        }
+        Ok(Self {
+            basis,
+            dofs,
+            harmonics,
+            termination: Termination::Converged,
+            history: vec![residual],
+            history_seconds: Vec::new(),
+            stats: SolveStats::default(),
+            wall_time: Duration::ZERO,
+        })
+    }
+
     /// `true` if the tolerance was met.
     pub fn is_converged(&self) -> bool {
         self.termination == Termination::Converged

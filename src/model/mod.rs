@@ -111,6 +111,18 @@ impl Model {
         self.loads.iter().map(|l| l.order).max().unwrap_or(0)
     }
 
+    /// The load `f(θ)` from `(cos θ, sin θ)`, added into `out` (length n): `cos kθ`, `sin kθ`
+    /// by the recurrence `e^{ikθ} = e^{iθ} e^{i(k-1)θ}` (no trigonometric call).
+    pub fn load_into_phasor(&self, cos: f64, sin: f64, out: &mut [f64]) {
+        for l in &self.loads {
+            let (mut c, mut s) = (1.0, 0.0);
+            for _ in 0..l.order {
+                (c, s) = (c * cos - s * sin, s * cos + c * sin);
+            }
+            out[l.dof] += l.cos * c + l.sin * s;
+        }
+    }
+
     /// The load `f(θ)` at angle `θ = Ω t`, added into `out` (length n).
     pub fn load_into(&self, theta: f64, out: &mut [f64]) {
         for l in &self.loads {

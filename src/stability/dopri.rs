@@ -5,6 +5,9 @@
 //! `y₁ = y + h Σ b_i k_i` and the error estimate `h Σ e_i k_i` (difference to the embedded
 //! fourth-order solution). The caller owns the loop: step-size control, events and restarts.
 
+// Numerical kernels index several arrays in lock step.
+#![allow(clippy::needless_range_loop)]
+
 /// Nodes `c_i`.
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
 /// Coupling coefficients `a_ij` (row i, j < i).

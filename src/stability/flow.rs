@@ -20,6 +20,9 @@
 //! `-M⁻¹ w Δf (wᵀ δq) / u̇` to `δq̇`. A time jump needs no saltation (its switching surface does
 //! not depend on the state).
 
+// Numerical kernels index several arrays in lock step.
+#![allow(clippy::needless_range_loop)]
+
 use super::dopri::{hermite, step_factor, Stepper};
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -63,12 +66,18 @@ pub(crate) struct Flow<'m> {
     scale_q: f64,
     omega_s: f64,
     atol: Vec<f64>,
+    /// `M⁻¹K/ω_s`, `M⁻¹D` (row-major) and `M⁻¹w_e` per element.
+    mk0: Vec<f64>,
+    md0: Vec<f64>,
+    mw: Vec<Vec<f64>>,
     // Buffers.
-    acc: Vec<f64>,
-    kt: DMatrix<f64>,
-    dt: DMatrix<f64>,
-    bk: DMatrix<f64>,
-    cd: DMatrix<f64>,
+    load: Vec<f64>,
+    bk: Vec<f64>,
+    cd: Vec<f64>,
+    /// `(t_b, cos Ωt_b, sin Ωt_b)`: the phasor at the current step start.
+    phasor_base: (f64, f64, f64),
+    /// The step size at the end of the last period (the next one starts with it).
+    h_last: f64,
     /// Steps taken (accepted and rejected).
     pub steps: usize,
 }
@@ -114,7 +123,7 @@ impl<'m> Flow<'m> {
         Ok(Self {
             model,
             n,
-            m_inv,
+            m_inv: m_inv.clone(),
             omega,
             bounds: crate::timesim::segment_bounds(model),
             segment: (0.0, 0.0, 0.0, std::f64::consts::TAU),
@@ -122,11 +131,22 @@ impl<'m> Flow<'m> {
             scale_q,
             omega_s: scale_v / scale_q,
             atol,
-            acc: vec![0.0; n],
-            kt: DMatrix::zeros(n, n),
-            dt: DMatrix::zeros(n, n),
-            bk: DMatrix::zeros(n, n),
-            cd: DMatrix::zeros(n, n),
+            mk0: row_major(&(&m_inv * model.structural_stiffness() / (scale_v / scale_q))),
+            md0: row_major(&(&m_inv * model.structural_damping())),
+            mw: model
+                .elements()
+                .iter()
+                .map(|e| {
+                    (0..n)
+                        .map(|i| e.weights().iter().map(|&(j, wj)| m_inv[(i, j)] * wj).sum())
+                        .collect()
+                })
+                .collect(),
+            load: vec![0.0; n],
+            bk: vec![0.0; n * n],
+            cd: vec![0.0; n * n],
+            h_last: 0.0,
+            phasor_base: (0.0, 1.0, 0.0),
             steps: 0,
         })
     }
@@ -158,56 +178,104 @@ impl<'m> Flow<'m> {
         (f + k * (u - inside), k, d)
     }
 
-    /// The right-hand side of the augmented state.
+    /// The right-hand side of the augmented state:
+    /// `q̈ = M⁻¹(f(θ) - D q̇ - K q - Σ w_e f_e)` and `Φ̃' = Ã(t) Φ̃`.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
         let n = self.n;
         let (ta, tha, lo, hi) = self.segment;
         let theta = (tha + self.omega * (t - ta)).clamp(lo, hi);
         let (q, rest) = y.split_at(n);
         let (v, phi) = rest.split_at(n);
-        self.acc.fill(0.0);
-        self.model.load_into(theta, &mut self.acc);
-        let (d, k) = (
-            self.model.structural_damping(),
-            self.model.structural_stiffness(),
-        );
-        self.kt.copy_from(k);
-        self.dt.copy_from(d);
+        let (dq, rest) = dy.split_at_mut(n);
+        let (dv, dphi) = rest.split_at_mut(n);
+        dq.copy_from_slice(v);
+        self.load.fill(0.0);
+        let (c, s) = self.phasor(t);
+        self.model.load_into_phasor(c, s, &mut self.load);
+        self.bk.copy_from_slice(&self.mk0);
+        self.cd.copy_from_slice(&self.md0);
         for i in 0..n {
-            let mut s = 0.0;
+            let (mut s, row) = (0.0, i * n);
             for j in 0..n {
-                s += d[(i, j)] * v[j] + k[(i, j)] * q[j];
+                s += self.m_inv[(i, j)] * self.load[j]
+                    - self.md0[row + j] * v[j]
+                    - self.mk0[row + j] * self.omega_s * q[j];
             }
-            self.acc[i] -= s;
+            dv[i] = s;
         }
         for (ei, e) in self.model.elements().iter().enumerate() {
             let (f, ke, de) = self.element_law(ei, theta, e.gather(q), e.gather(v));
-            e.scatter_add(-f, &mut self.acc);
-            e.add_outer(&mut self.kt, ke);
-            e.add_outer(&mut self.dt, de);
+            let mw = &self.mw[ei];
+            let ks = ke / self.omega_s;
+            for i in 0..n {
+                dv[i] -= f * mw[i];
+                if ks != 0.0 || de != 0.0 {
+                    for &(j, wj) in e.weights() {
+                        self.bk[i * n + j] += ks * mw[i] * wj;
+                        self.cd[i * n + j] += de * mw[i] * wj;
+                    }
+                }
+            }
         }
-        dy[..n].copy_from_slice(v);
-        for i in 0..n {
-            dy[n + i] = (0..n).map(|j| self.m_inv[(i, j)] * self.acc[j]).sum();
-        }
-        self.m_inv.mul_to(&self.kt, &mut self.bk);
-        self.bk /= self.omega_s;
-        self.m_inv.mul_to(&self.dt, &mut self.cd);
         let s2 = 2 * n;
-        let dphi = &mut dy[s2..];
         for c in 0..s2 {
             let col = &phi[c * s2..(c + 1) * s2];
             let (top, bot) = col.split_at(n);
             let out = &mut dphi[c * s2..(c + 1) * s2];
             for i in 0..n {
                 out[i] = self.omega_s * bot[i];
-                let mut s = 0.0;
+                let (mut s, row) = (0.0, i * n);
                 for j in 0..n {
-                    s += self.bk[(i, j)] * top[j] + self.cd[(i, j)] * bot[j];
+                    s += self.bk[row + j] * top[j] + self.cd[row + j] * bot[j];
                 }
                 out[n + i] = -s;
             }
         }
+    }
+
+    /// `(cos Ωt, sin Ωt)` from the phasor at the step start by a short Taylor series of
+    /// `e^{iΩ(t - t_b)}` (a stage is at most one step from it); `sin_cos` further away.
+    fn phasor(&self, t: f64) -> (f64, f64) {
+        let (tb, cb, sb) = self.phasor_base;
+        let x = self.omega * (t - tb);
+        let (cx, sx) = if x.abs() <= 0.25 {
+            // Terms up to x¹³/13! (< 3e-16 for |x| <= 1/4), Horner form.
+            let x2 = x * x;
+            let c = 1.0
+                - x2 * (1.0 / 2.0)
+                    * (1.0
+                        - x2 * (1.0 / 12.0)
+                            * (1.0
+                                - x2 * (1.0 / 30.0)
+                                    * (1.0
+                                        - x2 * (1.0 / 56.0)
+                                            * (1.0
+                                                - x2 * (1.0 / 90.0)
+                                                    * (1.0 - x2 * (1.0 / 132.0))))));
+            let s = x
+                * (1.0
+                    - x2 * (1.0 / 6.0)
+                        * (1.0
+                            - x2 * (1.0 / 20.0)
+                                * (1.0
+                                    - x2 * (1.0 / 42.0)
+                                        * (1.0
+                                            - x2 * (1.0 / 72.0)
+                                                * (1.0
+                                                    - x2 * (1.0 / 110.0)
+                                                        * (1.0 - x2 * (1.0 / 156.0)))))));
+            (c, s)
+        } else {
+            let (s, c) = x.sin_cos();
+            (c, s)
+        };
+        (cb * cx - sb * sx, sb * cx + cb * sx)
+    }
+
+    /// Moves the phasor base to `t`.
+    fn set_phasor_base(&mut self, t: f64) {
+        let (s, c) = (self.omega * t).sin_cos();
+        self.phasor_base = (t, c, s);
     }
 
     /// Sets each element's piece from the state `(q, q̇)` at the start.
@@ -311,7 +379,11 @@ impl<'m> Flow<'m> {
     ) -> Result<()> {
         let n = self.n;
         let omega = self.omega;
-        let mut h = opts.h_max.min(0.01 * std::f64::consts::TAU / omega);
+        let mut h = if self.h_last > 0.0 {
+            self.h_last
+        } else {
+            opts.h_max.min(0.01 * std::f64::consts::TAU / omega)
+        };
         let (mut f0, mut ytmp) = (vec![0.0; y.len()], vec![0.0; y.len()]);
         for w in bounds.windows(2) {
             let (ta, tb) = (w[0] / omega, w[1] / omega);
@@ -327,6 +399,7 @@ impl<'m> Flow<'m> {
                         ),
                     });
                 }
+                self.set_phasor_base(t);
                 if fresh {
                     self.rhs(t, y, stepper.start_derivative());
                     fresh = false;
@@ -409,6 +482,7 @@ impl<'m> Flow<'m> {
                 fresh = true;
             }
         }
+        self.h_last = h;
         Ok(())
     }
 
@@ -457,4 +531,9 @@ impl<'m> Flow<'m> {
 fn nudge(x: f64, direction: f64) -> f64 {
     let step = 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE);
     x + direction * step
+}
+
+/// The entries of `a` row by row.
+fn row_major(a: &DMatrix<f64>) -> Vec<f64> {
+    a.transpose().as_slice().to_vec()
 }

@@ -131,7 +131,7 @@ impl Floquet {
 /// Options of the Floquet analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FloquetOptions {
-    /// Relative tolerance of the integrator. Default 1e-10.
+    /// Relative tolerance of the integrator. Default 1e-8 (multipliers to about 1e-7 or better).
     pub rtol: f64,
     /// Newton shooting iterations (0: the multipliers along the orbit started from the HB
     /// state). Default 6.
@@ -143,7 +143,7 @@ pub struct FloquetOptions {
 impl Default for FloquetOptions {
     fn default() -> Self {
         Self {
-            rtol: 1e-10,
+            rtol: 1e-8,
             max_shooting: 6,
             max_steps: 2_000_000,
         }
@@ -226,11 +226,13 @@ impl FloquetOptions {
             // Scaled shooting residual r̃ = S⁻¹ (φ_T(x₀) - x₀).
             let r = DVector::from_fn(s2, |i, _| (y[i] - x0[i]) / scale(i));
             let res = r.amax();
-            if res <= 100.0 * self.rtol {
+            // Converged to the integration noise, or Newton has stalled there.
+            if res <= 10.0 * self.rtol {
                 polished = true;
                 break;
             }
-            if iteration >= self.max_shooting || !(res < last_residual) {
+            if iteration >= self.max_shooting || !res.is_finite() || res >= 0.5 * last_residual {
+                polished = res <= 1e3 * self.rtol;
                 break;
             }
             last_residual = res;
@@ -288,7 +290,7 @@ fn scales(model: &Model, solution: &Solution) -> (f64, f64) {
     let n = model.n_dofs();
     let omega = solution.basis().omega();
     let samples = solution.basis().samples().max(16);
-    let series: Vec<Vec<f64>> = (0..n).map(|i| solution.time_series(i, samples)).collect();
+    let (series, rates) = sampled_orbit(solution, samples);
     let mut scale_q = series
         .iter()
         .flat_map(|s| s.iter())
@@ -306,7 +308,7 @@ fn scales(model: &Model, solution: &Solution) -> (f64, f64) {
             let theta = std::f64::consts::TAU * j as f64 / samples as f64;
             for i in 0..n {
                 q[i] = series[i][j];
-                v[i] = solution.velocity(i, theta);
+                v[i] = rates[i][j];
             }
             let (k, d) = e.law().derivatives(theta, e.gather(&q), e.gather(&v));
             km = km.max(k.abs());
@@ -333,4 +335,31 @@ fn scales(model: &Model, solution: &Solution) -> (f64, f64) {
         }
     }
     (scale_q, omega_max)
+}
+
+/// `(q_i(θ_j), q̇_i(θ_j))` at `samples` equidistant angles, by the recurrence
+/// `e^{ikθ} = e^{iθ} e^{i(k-1)θ}` (one sine and cosine per sample).
+fn sampled_orbit(solution: &Solution, samples: usize) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let n = solution.dof_names().len();
+    let h = solution.basis().harmonics();
+    let omega = solution.basis().omega();
+    let harmonics = solution.harmonics();
+    let mut q = vec![vec![0.0; samples]; n];
+    let mut v = vec![vec![0.0; samples]; n];
+    for j in 0..samples {
+        let step = Complex64::from_polar(1.0, std::f64::consts::TAU * j as f64 / samples as f64);
+        let mut rot = Complex64::new(1.0, 0.0);
+        for i in 0..n {
+            q[i][j] = harmonics[i].re;
+        }
+        for k in 1..=h {
+            rot *= step;
+            for i in 0..n {
+                let z = harmonics[k * n + i] * rot;
+                q[i][j] += z.re;
+                v[i][j] -= k as f64 * omega * z.im;
+            }
+        }
+    }
+    (q, v)
 }
