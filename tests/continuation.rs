@@ -49,9 +49,56 @@ fn duffing_one_harmonic_branch_is_the_analytic_curve() {
         (upper - backbone).abs() < 2e-3,
         "fold {upper} vs backbone {backbone}"
     );
-    // Stable outer branches, unstable middle branch: stability changes exactly at the folds.
-    let changes: Vec<_> = branch.points.iter().filter_map(|p| p.bifurcation).collect();
-    assert_eq!(changes, vec![Bifurcation::Fold, Bifurcation::Fold]);
+}
+
+/// Stable outer branches, unstable middle branch: with H = 7 (the HB orbit within about 1e-6 of
+/// the exact one) the stability of the exact orbit changes exactly at the two folds of the
+/// branch, from a real multiplier through +1.
+#[test]
+fn duffing_stability_changes_at_the_folds() {
+    let d = Duffing {
+        c: 0.01,
+        force: 0.01,
+        ..Duffing::default()
+    };
+    let model = d.model().unwrap();
+    let branch = Continuation::default()
+        .run(&model, HarmonicBasis::new(0.6, 7).unwrap(), 2.0, |_| {})
+        .unwrap();
+    assert_eq!(branch.folds(), 2);
+    let changes: Vec<_> = branch
+        .points
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| p.bifurcation.map(|b| (i, b)))
+        .collect();
+    let folds: Vec<_> = branch
+        .points
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.fold)
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(
+        changes.iter().map(|c| c.1).collect::<Vec<_>>(),
+        vec![Bifurcation::Fold, Bifurcation::Fold]
+    );
+    for ((i, _), f) in changes.iter().zip(&folds) {
+        assert!(
+            i.abs_diff(*f) <= 1,
+            "stability change at point {i}, fold at {f}"
+        );
+    }
+    for p in &branch.points {
+        let f = p.floquet.as_ref().unwrap();
+        // Next to a fold (a multiplier near 1) the shooting correction is amplified by
+        // 1/|1 - μ|: up to 3e-4 here.
+        assert!(
+            f.polished && f.orbit_correction < 1e-3,
+            "Ω {}: {f:?}",
+            p.omega
+        );
+    }
 }
 
 /// The fold locations converge as H grows (Duffing, F = 0.1, through both folds).
