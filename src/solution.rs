@@ -114,6 +114,13 @@ impl Solution {
         })
     }
 
+    /// Floquet stability of this periodic solution of `model` (default
+    /// [`FloquetOptions`](crate::stability::FloquetOptions)): the multipliers of the exact
+    /// periodic orbit next to it, found by Newton shooting from this solution.
+    pub fn stability(&self, model: &crate::Model) -> crate::Result<crate::stability::Floquet> {
+        crate::stability::floquet(model, self)
+    }
+
     /// `true` if the tolerance was met.
     pub fn is_converged(&self) -> bool {
         self.termination == Termination::Converged

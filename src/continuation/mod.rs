@@ -38,6 +38,9 @@ pub struct BranchPoint {
     pub max_abs: Vec<f64>,
     /// Relative residual.
     pub residual: f64,
+    /// Truncation estimate of the point ([`Solution::truncation_estimate`](crate::Solution::truncation_estimate)).
+    #[serde(default)]
+    pub truncation: f64,
     /// Floquet multipliers, if computed.
     pub floquet: Option<Floquet>,
     /// A turning point of the branch lies between the previous point and this one.
@@ -451,12 +454,14 @@ impl Continuation {
             _ => None,
         };
         let max_abs = (0..model.n_dofs()).map(|i| sol.max_abs(i)).collect();
+        let truncation = sol.truncation_estimate();
         branch.points.push(BranchPoint {
             parameter: omega,
             omega,
             harmonics: sol.harmonics,
             max_abs,
             residual,
+            truncation,
             floquet,
             fold,
             fold_omega: None,
