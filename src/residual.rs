@@ -358,6 +358,15 @@ impl<'m> HarmonicBalance<'m> {
         Ok(())
     }
 
+    /// Multiplies the alternating load (harmonics `k >= 1` of `F_ext`) by `factor`; the static
+    /// load stays. For a homotopy in the load amplitude.
+    pub fn scale_alternating_load(&mut self, factor: f64) {
+        let n = self.model.n_dofs();
+        for v in self.f_ext[n..].iter_mut().chain(self.f_split[n..].iter_mut()) {
+            *v *= factor;
+        }
+    }
+
     /// Moves the discretisation to a new fundamental Ω (rebuilds and factors `Z_k`); for
     /// sweeps. Errors as [`HarmonicBalance::new`] on a singular `Z_k`.
     pub fn set_omega(&mut self, omega: f64) -> Result<()> {

@@ -14,6 +14,7 @@ mod method;
 mod newton;
 mod problem;
 mod run;
+mod start;
 
 pub use anderson::{Anderson, AndersonSolver};
 pub use broyden::{Broyden, BroydenSolver, InitialJacobian};
@@ -22,6 +23,7 @@ pub use method::Method;
 pub use newton::{Newton, NewtonSolver};
 pub use problem::HbProblem;
 pub use run::{HbSolver, HbState, Progress, MAX_DENSE_UNKNOWNS};
+pub use start::{robust_start, StartReport};
 
 /// The dense-Jacobian guard, for continuation.
 pub(crate) fn check_dense_for_continuation(hb: &crate::HarmonicBalance) -> crate::Result<()> {
