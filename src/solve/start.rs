@@ -84,7 +84,7 @@ fn load_homotopy(
 ) -> Result<Option<StartReport>> {
     const MIN_STEP: f64 = 1e-3;
     let mut scale = 1.0;
-    let mut set = |hb: &mut HarmonicBalance, scale: &mut f64, s: f64| {
+    let set = |hb: &mut HarmonicBalance, scale: &mut f64, s: f64| {
         hb.scale_alternating_load(s / *scale);
         *scale = s;
     };

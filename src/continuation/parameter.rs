@@ -1,0 +1,103 @@
+//! A warm-started sweep over any parameter (it does not follow folds).
+
+use super::point::NewPoint;
+use super::{Branch, BranchStop, Continuation};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::residual::HarmonicBalance;
+use crate::solve::{robust_start, Newton};
+use crate::stability::FloquetOptions;
+use crate::HarmonicBasis;
+use num_complex::Complex64;
+
+/// A warm-started sweep over any parameter: `build(p)` gives the model and basis at `p`; each
+/// point starts Newton from the previous one. It stops with [`BranchStop::NotConverged`] where
+/// Newton fails (it does not follow folds). Stability as in [`Continuation`].
+pub fn parameter_sweep(
+    values: &[f64],
+    mut build: impl FnMut(f64) -> Result<(Model, HarmonicBasis)>,
+    stability: Option<FloquetOptions>,
+    mut progress: impl FnMut(f64),
+) -> Result<Branch> {
+    let mut branch: Option<Branch> = None;
+    let mut previous: Option<Vec<Complex64>> = None;
+    let cont = Continuation {
+        stability,
+        ..Continuation::default()
+    };
+    for (i, &p) in values.iter().enumerate() {
+        let (model, basis) = match build(p) {
+            Ok(v) => v,
+            Err(e) => match branch.as_mut() {
+                // Keep the points so far.
+                Some(b) => {
+                    b.stop = BranchStop::InvalidParameter {
+                        parameter: p,
+                        reason: e.to_string(),
+                    };
+                    break;
+                }
+                None => return Err(e),
+            },
+        };
+        let mut hb = HarmonicBalance::new(&model, basis)?;
+        crate::solve::check_dense_for_continuation(&hb)?;
+        let mut ws = hb.workspace();
+        let sol = match &previous {
+            Some(q) if q.len() == hb.len() => Newton::new()
+                .with_tolerance(cont.tolerance)?
+                .solve_from(&hb, q, &mut ws)?,
+            // The first value: the robust start (other solvers, load homotopy).
+            _ => {
+                let start = robust_start(&mut hb, &cont.method, None, cont.tolerance, &mut ws)?;
+                if let Some(b) = branch.as_mut() {
+                    b.start = start.how;
+                } else {
+                    branch = Some(Branch {
+                        dofs: model.dof_names().to_vec(),
+                        harmonics: basis.harmonics(),
+                        points: Vec::new(),
+                        start: start.how,
+                        stop: BranchStop::Reached,
+                    });
+                }
+                start.solution
+            }
+        };
+        let b = branch.get_or_insert_with(|| Branch {
+            dofs: model.dof_names().to_vec(),
+            harmonics: basis.harmonics(),
+            points: Vec::new(),
+            start: String::new(),
+            stop: BranchStop::Reached,
+        });
+        if !sol.is_converged() {
+            b.stop = if i == 0 {
+                BranchStop::StartFailed {
+                    reason: sol.termination.to_string(),
+                }
+            } else {
+                BranchStop::NotConverged { parameter: p }
+            };
+            break;
+        }
+        previous = Some(sol.harmonics().to_vec());
+        let point = NewPoint {
+            basis,
+            harmonics: sol.harmonics().to_vec(),
+            parameter: p,
+            residual: sol.residual(),
+            turn: false,
+            turn_omega: None,
+        };
+        if let Some(reason) = cont.push_point(b, &model, point) {
+            b.stop = BranchStop::StabilityFailed {
+                omega: basis.omega(),
+                reason,
+            };
+            break;
+        }
+        progress((i + 1) as f64 / values.len() as f64);
+    }
+    branch.ok_or_else(|| Error::invalid("parameter sweep", "values", 0.0, "at least one value"))
+}

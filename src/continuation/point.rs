@@ -1,0 +1,142 @@
+//! A new point on a branch: its stability, whether a turning point before it is a real fold,
+//! and which bifurcation a stability change is.
+//!
+//! A turning point of the discretised branch (the tangent's Ω component changes sign) is a
+//! fold of the exact problem when the number of real multipliers greater than 1 changes parity
+//! between its two neighbours (`det(I - Φ)` changes sign: a multiplier passes through +1).
+//! Non-smooth branches also turn at corners, and an under-sampled contact kink makes the
+//! discretised branch zig-zag; the exact orbits on both sides then have the same multipliers,
+//! and the turn is reported as spurious, not as a fold.
+//!
+//! Turns and parity changes close together (within 12 points and 5e-3 relative in Ω) form one
+//! cluster: near a fold of a non-smooth branch the discretised branch may zig-zag and the
+//! exact orbits' multipliers flicker around 1. A cluster with turns is one fold (at its first
+//! turn) if the parity of the real multipliers above 1 differs between the point two before
+//! the cluster and the point after it (without stability: if it has an odd number of turns);
+//! otherwise all its turns are spurious.
+
+use super::{Branch, BranchPoint, Continuation};
+use crate::model::Model;
+use crate::solution::Solution;
+use crate::HarmonicBasis;
+use num_complex::Complex64;
+
+/// What the caller knows about a new point.
+pub(super) struct NewPoint {
+    pub basis: HarmonicBasis,
+    pub harmonics: Vec<Complex64>,
+    pub parameter: f64,
+    pub residual: f64,
+    /// The tangent's Ω component changed sign since the previous point.
+    pub turn: bool,
+    /// The turning point's Ω, interpolated.
+    pub turn_omega: Option<f64>,
+}
+
+impl Continuation {
+    /// Appends `p` to `branch` with its stability. A failed stability computation still
+    /// appends the point (without multipliers) and returns the reason.
+    pub(super) fn push_point(
+        &self,
+        branch: &mut Branch,
+        model: &Model,
+        p: NewPoint,
+    ) -> Option<String> {
+        let omega = p.basis.omega();
+        let sol = match Solution::from_harmonics(
+            p.basis,
+            model.dof_names().to_vec(),
+            p.harmonics,
+            p.residual,
+        ) {
+            Ok(s) => s,
+            Err(e) => return Some(e.to_string()),
+        };
+        let (floquet, failure) = match &self.stability {
+            Some(options) => match options.compute(model, &sol) {
+                Ok(f) => (Some(f), None),
+                Err(e) => (None, Some(format!("stability at Ω = {omega}: {e}"))),
+            },
+            None => (None, None),
+        };
+        let prev = branch.points.last().and_then(|q| q.floquet.clone());
+        let prev_stable = prev.as_ref().map(|f| f.is_stable());
+        let stable = floquet.as_ref().map(|f| f.is_stable());
+        // The kind comes from the unstable side, where the critical multiplier is outside.
+        let bifurcation = match (prev_stable, stable) {
+            (Some(true), Some(false)) => floquet.as_ref().and_then(|f| f.critical()),
+            (Some(false), Some(true)) => prev.as_ref().and_then(|f| f.critical()),
+            _ => None,
+        };
+        let max_abs = (0..model.n_dofs()).map(|i| sol.max_abs(i)).collect();
+        let truncation = sol.truncation_estimate();
+        branch.points.push(BranchPoint {
+            parameter: p.parameter,
+            omega,
+            harmonics: sol.harmonics,
+            max_abs,
+            residual: p.residual,
+            truncation,
+            floquet,
+            // Tentative: [`classify_turns`] decides once the neighbours are known.
+            fold: p.turn,
+            spurious_turn: false,
+            fold_omega: p.turn_omega,
+            bifurcation,
+        });
+        failure
+    }
+}
+
+/// Decides which tentative turns of `branch` are folds (module documentation).
+pub(super) fn classify_turns(branch: &mut Branch) {
+    let pts = &mut branch.points;
+    let parity = |p: &BranchPoint| p.floquet.as_ref().map(|f| f.real_unstable() % 2);
+    // Events: tentative turns, and points whose parity differs from the previous point's.
+    let mut events: Vec<(usize, bool)> = Vec::new();
+    for i in 0..pts.len() {
+        let changed =
+            i > 0 && matches!((parity(&pts[i - 1]), parity(&pts[i])), (Some(a), Some(b)) if a != b);
+        if pts[i].fold || changed {
+            events.push((i, pts[i].fold));
+        }
+    }
+    let mut clusters: Vec<Vec<(usize, bool)>> = Vec::new();
+    for e in events {
+        match clusters.last_mut() {
+            Some(c)
+                if e.0 - c[c.len() - 1].0 <= CLUSTER_POINTS
+                    && (pts[e.0].omega - pts[c[c.len() - 1].0].omega).abs()
+                        <= CLUSTER_WIDTH * pts[e.0].omega.abs() =>
+            {
+                c.push(e)
+            }
+            _ => clusters.push(vec![e]),
+        }
+    }
+    for c in clusters {
+        let turns: Vec<usize> = c.iter().filter(|e| e.1).map(|e| e.0).collect();
+        if turns.is_empty() {
+            continue;
+        }
+        let before = c[0].0.saturating_sub(2);
+        let after = (c[c.len() - 1].0 + 1).min(pts.len() - 1);
+        let confirmed = match (parity(&pts[before]), parity(&pts[after])) {
+            (Some(a), Some(b)) => a != b,
+            _ => turns.len() % 2 == 1,
+        };
+        for (j, &i) in turns.iter().enumerate() {
+            let fold = confirmed && j == 0;
+            pts[i].fold = fold;
+            pts[i].spurious_turn = !fold;
+            if !fold {
+                pts[i].fold_omega = None;
+            }
+        }
+    }
+}
+
+/// Events at most this many points apart belong to one cluster...
+const CLUSTER_POINTS: usize = 12;
+/// ...if their Ω also differ by at most this fraction.
+const CLUSTER_WIDTH: f64 = 5e-3;
