@@ -362,7 +362,10 @@ impl<'m> HarmonicBalance<'m> {
     /// load stays. For a homotopy in the load amplitude.
     pub fn scale_alternating_load(&mut self, factor: f64) {
         let n = self.model.n_dofs();
-        for v in self.f_ext[n..].iter_mut().chain(self.f_split[n..].iter_mut()) {
+        for v in self.f_ext[n..]
+            .iter_mut()
+            .chain(self.f_split[n..].iter_mut())
+        {
             *v *= factor;
         }
     }
