@@ -1,7 +1,8 @@
 //! The `hbal` command line: solve, compare and check scene files.
 //!
-//! Exit codes: 0 success, 1 a solve that did not converge (its partial result is still
-//! reported and written), 2 bad input (the message names the file and the field).
+//! Exit codes: 0 success, 1 a numerical failure: a solve that did not converge, a branch that
+//! stopped before `--to`, a failed stability computation (the partial result is still reported
+//! and written), 2 bad input (the message names the file and the field).
 
 mod cli;
 
@@ -22,16 +23,18 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Solve a scene: summary, CSV of harmonics and time series, SVG plots.
+    /// Solve a scene: summary with Floquet stability, CSV of harmonics and time series, SVG plots.
     Solve {
         /// Scene file (.toml or .json).
         scene: PathBuf,
-        /// Solver: fixed_point, newton, broyden, anderson (default: the scene's).
+        #[command(flatten)]
+        solver: cli::SolverArgs,
+        /// Start from a previous `hbal solve --json` result instead of the linear solution.
+        #[arg(long, value_name = "FILE")]
+        start: Option<PathBuf>,
+        /// Skip the Floquet stability of the converged orbit.
         #[arg(long)]
-        method: Option<String>,
-        /// Number of harmonics H (default: the scene's).
-        #[arg(long)]
-        harmonics: Option<usize>,
+        no_stability: bool,
         /// Print exactly one JSON object on stdout instead of the summary.
         #[arg(long)]
         json: bool,
@@ -39,10 +42,12 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Every solver and the time-domain reference on one scene.
+    /// Every solver (or the one of --method) and the time-domain reference on one scene.
     Compare {
         /// Scene file (.toml or .json).
         scene: PathBuf,
+        #[command(flatten)]
+        solver: cli::SolverArgs,
         /// Print exactly one JSON object on stdout instead of the table.
         #[arg(long)]
         json: bool,
@@ -56,12 +61,23 @@ enum Command {
     Sweep {
         /// Scene file (.toml or .json).
         scene: PathBuf,
-        /// Start speed (the scene's unit).
+        /// Start speed (the scene's unit; default: the --start file's speed, else the scene's).
         #[arg(long)]
-        from: f64,
+        from: Option<f64>,
         /// End speed (the scene's unit).
         #[arg(long)]
         to: f64,
+        #[command(flatten)]
+        solver: cli::SolverArgs,
+        /// Start the branch from a previous `hbal solve --json` result.
+        #[arg(long, value_name = "FILE")]
+        start: Option<PathBuf>,
+        /// Skip the Floquet stability of the points.
+        #[arg(long)]
+        no_stability: bool,
+        /// Stop after this many points (exit code 1 if --to is not reached; default 2000).
+        #[arg(long)]
+        max_points: Option<usize>,
         /// Print exactly one JSON object on stdout instead of the summary.
         #[arg(long)]
         json: bool,
@@ -95,19 +111,36 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Solve {
             scene,
-            method,
-            harmonics,
+            solver,
+            start,
+            no_stability,
             json,
             out,
-        } => cli::solve::solve(&scene, method.as_deref(), harmonics, json, out.as_deref()),
-        Command::Compare { scene, json, out } => {
-            cli::compare::compare(&scene, json, out.as_deref())
-        }
+        } => cli::solve::solve(
+            &scene,
+            &solver,
+            cli::solve::SolveOptions {
+                start: start.as_deref(),
+                stability: !no_stability,
+                json,
+                out: out.as_deref(),
+            },
+        ),
+        Command::Compare {
+            scene,
+            solver,
+            json,
+            out,
+        } => cli::compare::compare(&scene, &solver, json, out.as_deref()),
         Command::Check { scene } => cli::check::check(&scene),
         Command::Sweep {
             scene,
             from,
             to,
+            solver,
+            start,
+            no_stability,
+            max_points,
             json,
             out,
             max_step,
@@ -117,13 +150,31 @@ fn main() -> ExitCode {
             Some(name) => cli::parameter_sweep::parameter_sweep(
                 &scene,
                 &name,
-                from,
-                to,
-                points,
-                json,
-                out.as_deref(),
+                cli::parameter_sweep::ParameterSweep {
+                    from,
+                    to,
+                    points,
+                    solver: &solver,
+                    start: start.as_deref(),
+                    stability: !no_stability,
+                    json,
+                    out: out.as_deref(),
+                },
             ),
-            None => cli::sweep::sweep(&scene, from, to, json, out.as_deref(), max_step),
+            None => cli::sweep::sweep(
+                &scene,
+                &solver,
+                cli::sweep::SweepOptions {
+                    from,
+                    to,
+                    start: start.as_deref(),
+                    stability: !no_stability,
+                    max_points,
+                    max_step,
+                    json,
+                    out: out.as_deref(),
+                },
+            ),
         },
     };
     match result {

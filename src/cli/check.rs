@@ -7,7 +7,7 @@ use hbal::HarmonicBalance;
 use std::path::Path;
 
 pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
-    let scene = load(path, None, None)?;
+    let scene = load(path, &super::SolverArgs::default())?;
     HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
     say!(
         "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s, H = {}, N = {}, solver {})",

@@ -1,7 +1,8 @@
-//! `hbal compare`: run every solver and the time-domain reference on one scene, and print a
-//! table (or one JSON object) of results, timings and errors against the time domain.
+//! `hbal compare`: run every solver (or the one of `--method`) and the time-domain reference on
+//! one scene, and print a table (or one JSON object) of results, timings and errors against the
+//! time domain.
 
-use super::{load, Failure};
+use super::{load, Failure, SolverArgs};
 use anyhow::Context;
 use hbal::compare::relative_error;
 use hbal::report::{line_plot, Axis, Series};
@@ -11,14 +12,23 @@ use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
 
-pub(crate) fn compare(path: &Path, as_json: bool, out: Option<&Path>) -> Result<u8, Failure> {
-    let scene = load(path, None, None)?;
+pub(crate) fn compare(
+    path: &Path,
+    args: &SolverArgs,
+    as_json: bool,
+    out: Option<&Path>,
+) -> Result<u8, Failure> {
+    let scene = load(path, args)?;
+    let names: Vec<&str> = match &args.method {
+        Some(_) => vec![scene.method.name()],
+        None => hbal::scene::METHODS.to_vec(),
+    };
     let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
     let h = scene.basis.harmonics();
     let n = scene.model.n_dofs();
     let mut solutions = Vec::new();
-    for name in hbal::scene::METHODS {
-        let method: Method = scene.method_named(name)?;
+    for name in names {
+        let method: Method = args.method_named(&scene, name)?;
         let mut ws = hb.workspace();
         let start = Instant::now();
         let sol = method.solve(&hb, None, &mut ws)?;

@@ -1,10 +1,13 @@
 //! Shared pieces of the `hbal` subcommands: the `say!` macro, the `Failure` error with its
-//! exit code, and scene loading with the command-line overrides (`--method`, `--harmonics`).
-//! Each subcommand lives in its own file below.
+//! exit code, the solver overrides shared by `solve`, `compare` and `sweep` (`--method`,
+//! `--harmonics`, `--samples`, `--tolerance`) and scene loading with them, and the JSON of
+//! Floquet multipliers. Each subcommand lives in its own file below.
 
 use anyhow::Context;
 use hbal::scene::Scene;
-use hbal::HarmonicBasis;
+use hbal::stability::Floquet;
+use hbal::{HarmonicBasis, Method};
+use serde_json::json;
 use std::path::Path;
 
 /// `println!` that ends the process quietly when stdout is closed (`hbal ... | head`).
@@ -23,6 +26,7 @@ pub(crate) mod check;
 pub(crate) mod compare;
 pub(crate) mod parameter_sweep;
 pub(crate) mod solve;
+pub(crate) mod start;
 pub(crate) mod sweep;
 
 /// An error with its exit code.
@@ -40,21 +44,115 @@ impl<E: Into<anyhow::Error>> From<E> for Failure {
     }
 }
 
+/// Exit code of a library error: 1 for a numerical failure (a non-finite value, a failed
+/// integration or solver), 2 for bad input.
+pub(crate) fn exit_code(e: &hbal::Error) -> u8 {
+    match e {
+        hbal::Error::NonFinite { .. }
+        | hbal::Error::Solver { .. }
+        | hbal::Error::TimeIntegration { .. } => 1,
+        _ => 2,
+    }
+}
+
+/// The solver overrides of `solve`, `compare` and `sweep`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub(crate) struct SolverArgs {
+    /// Solver: fixed_point, newton, broyden, anderson (default: the scene's).
+    #[arg(long)]
+    pub(crate) method: Option<String>,
+    /// Number of harmonics H (default: the scene's).
+    #[arg(long)]
+    pub(crate) harmonics: Option<usize>,
+    /// Number of time samples N per period, at least 2H+1 (default: the scene's, or the
+    /// default for --harmonics).
+    #[arg(long)]
+    pub(crate) samples: Option<usize>,
+    /// Relative residual tolerance of the solver, in [0, 1) (default: the scene's).
+    #[arg(long)]
+    pub(crate) tolerance: Option<f64>,
+}
+
+impl SolverArgs {
+    /// The scene's solver settings applied to method `name`, with `--tolerance`.
+    pub(crate) fn method_named(&self, scene: &Scene, name: &str) -> Result<Method, Failure> {
+        let method = scene.method_named(name)?;
+        self.with_tolerance(method, &scene.file)
+    }
+
+    fn with_tolerance(&self, method: Method, file: &str) -> Result<Method, Failure> {
+        let Some(t) = self.tolerance else {
+            return Ok(method);
+        };
+        let context = || format!("{file}: --tolerance");
+        Ok(match method {
+            Method::FixedPoint(o) => Method::FixedPoint(o.with_tolerance(t).with_context(context)?),
+            Method::Newton(o) => Method::Newton(o.with_tolerance(t).with_context(context)?),
+            Method::Broyden(o) => Method::Broyden(o.with_tolerance(t).with_context(context)?),
+            Method::Anderson(o) => Method::Anderson(o.with_tolerance(t).with_context(context)?),
+        })
+    }
+}
+
 /// Loads the scene and applies the command-line overrides.
-pub(crate) fn load(
-    path: &Path,
-    method: Option<&str>,
-    harmonics: Option<usize>,
-) -> Result<Scene, Failure> {
+pub(crate) fn load(path: &Path, args: &SolverArgs) -> Result<Scene, Failure> {
     let mut scene = Scene::load(path)?;
-    if let Some(name) = method {
+    if let Some(name) = &args.method {
         scene.method = scene.method_named(name)?;
     }
-    if let Some(h) = harmonics {
-        let basis = HarmonicBasis::new(scene.basis.omega(), h)
-            .with_context(|| format!("{}: --harmonics", scene.file))?;
-        // Keep the scene's N where it can still carry H harmonics.
-        scene.basis = basis.with_samples(scene.basis.samples()).unwrap_or(basis);
-    }
+    scene.method = args.with_tolerance(scene.method, &scene.file)?;
+    scene.basis = basis_with(&scene.basis, args, &scene.file)?;
     Ok(scene)
+}
+
+/// `basis` with `--harmonics` and `--samples` applied.
+pub(crate) fn basis_with(
+    basis: &HarmonicBasis,
+    args: &SolverArgs,
+    file: &str,
+) -> Result<HarmonicBasis, Failure> {
+    let mut out = *basis;
+    if let Some(h) = args.harmonics {
+        let b =
+            HarmonicBasis::new(basis.omega(), h).with_context(|| format!("{file}: --harmonics"))?;
+        // Keep the scene's N where it can still carry H harmonics.
+        out = b.with_samples(basis.samples()).unwrap_or(b);
+    }
+    if let Some(n) = args.samples {
+        out = out
+            .with_samples(n)
+            .with_context(|| format!("{file}: --samples"))?;
+    }
+    Ok(out)
+}
+
+/// Multipliers as `[[re, im], ...]`.
+pub(crate) fn multipliers_json(f: &Floquet) -> serde_json::Value {
+    json!(f
+        .multipliers
+        .iter()
+        .map(|m| [m.re, m.im])
+        .collect::<Vec<_>>())
+}
+
+/// Checks that every multiplier is finite (a non-finite one would print as JSON `null`); the
+/// library promises it, and the command line does not pass a broken promise on.
+pub(crate) fn check_finite(f: &Floquet) -> Result<(), String> {
+    if f.multipliers
+        .iter()
+        .all(|m| m.re.is_finite() && m.im.is_finite())
+    {
+        Ok(())
+    } else {
+        Err("non-finite Floquet multiplier".into())
+    }
+}
+
+/// A multiplier modulus for the text summaries: 6 decimals, or 4 significant digits under 1e-3.
+pub(crate) fn modulus(x: f64) -> String {
+    if x == 0.0 || x >= 1e-3 {
+        format!("{x:.6}")
+    } else {
+        format!("{x:.3e}")
+    }
 }

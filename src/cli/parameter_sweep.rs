@@ -1,24 +1,50 @@
 //! `hbal sweep --parameter <field>`: a warm-started sweep of one numeric scene field over
-//! `--points` values (does not follow folds), with stability, and optionally branch.csv and
-//! one parameter-response SVG per DOF.
+//! `--points` values (does not follow folds), with stability (unless `--no-stability`), on the
+//! scene's basis or the one of `--harmonics`/`--samples`, and optionally branch.csv and one
+//! parameter-response SVG per DOF.
 
-use super::Failure;
+use super::{basis_with, Failure, SolverArgs};
 use anyhow::Context;
 use hbal::scene::Scene;
 use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
 
+/// Options of a `--parameter` sweep.
+pub(crate) struct ParameterSweep<'a> {
+    pub(crate) from: Option<f64>,
+    pub(crate) to: f64,
+    pub(crate) points: usize,
+    pub(crate) solver: &'a SolverArgs,
+    pub(crate) start: Option<&'a Path>,
+    pub(crate) stability: bool,
+    pub(crate) json: bool,
+    pub(crate) out: Option<&'a Path>,
+}
+
 pub(crate) fn parameter_sweep(
     path: &Path,
     name: &str,
-    from: f64,
-    to: f64,
-    points: usize,
-    as_json: bool,
-    out: Option<&Path>,
+    opts: ParameterSweep,
 ) -> Result<u8, Failure> {
     use hbal::continuation::{parameter_sweep, BranchStop};
+    let (to, points, as_json, out) = (opts.to, opts.points, opts.json, opts.out);
+    let Some(from) = opts.from else {
+        return Err(anyhow::anyhow!("--parameter needs --from").into());
+    };
+    // A parameter sweep is warm-started Newton from the linear solution.
+    for (flag, given) in [
+        ("--start", opts.start.is_some()),
+        ("--method", opts.solver.method.is_some()),
+        ("--tolerance", opts.solver.tolerance.is_some()),
+    ] {
+        if given {
+            return Err(anyhow::anyhow!(
+                "{flag} applies to speed sweeps, not to a --parameter sweep"
+            )
+            .into());
+        }
+    }
     let file = path.display().to_string();
     let text =
         std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read the file"))?;
@@ -30,7 +56,8 @@ pub(crate) fn parameter_sweep(
     let mut probe = doc.clone();
     hbal::scene::set_parameter(&mut probe, name, from)
         .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
-    Scene::from_value(probe, &file)?;
+    let probe = Scene::from_value(probe, &file)?;
+    basis_with(&probe.basis, opts.solver, &file)?;
     let values: Vec<f64> = (0..points)
         .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
         .collect();
@@ -48,19 +75,40 @@ pub(crate) fn parameter_sweep(
             let scene = Scene::from_value(d, &file).map_err(|e| hbal::Error::Solver {
                 reason: e.to_string(),
             })?;
-            Ok((scene.model, scene.basis))
+            let basis =
+                basis_with(&scene.basis, opts.solver, &file).map_err(|e| hbal::Error::Solver {
+                    reason: format!("{:#}", e.error),
+                })?;
+            Ok((scene.model, basis))
         },
-        None,
+        opts.stability
+            .then(hbal::stability::FloquetOptions::default),
         |f| bar.set_position((f * points as f64) as u64),
     )
-    .with_context(|| file.clone())?;
+    .map_err(|e| Failure {
+        code: super::exit_code(&e),
+        error: anyhow::Error::new(e).context(file.clone()),
+    })?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     if as_json {
         let pts: Vec<_> = branch
             .points
             .iter()
-            .map(|p| json!({"parameter": p.parameter, "stable": p.stable(), "bifurcation": p.bifurcation.map(|b| format!("{b:?}")), "max_abs": p.max_abs}))
+            .map(|p| {
+                json!({
+                    "parameter": p.parameter,
+                    "stable": p.stable(),
+                    "bifurcation": p.bifurcation.map(|b| format!("{b:?}")),
+                    "max_abs": p.max_abs,
+                    "residual": p.residual,
+                    "truncation": p.truncation,
+                    "multipliers": p.floquet.as_ref().map(super::multipliers_json),
+                    "multipliers_abs": p.floquet.as_ref().map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
+                    "neutral": p.floquet.as_ref().map(|f| f.neutral),
+                    "orbit_correction": p.floquet.as_ref().map(|f| f.orbit_correction),
+                })
+            })
             .collect();
         say!(
             "{}",

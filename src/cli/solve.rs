@@ -1,31 +1,68 @@
-//! `hbal solve`: solve one scene with its (or the given) solver, print a summary or one JSON
-//! object, and optionally write harmonics.csv, time_series.csv and SVG plots.
+//! `hbal solve`: solve one scene with its (or the given) solver, from the linear solution or a
+//! `--start` file, compute the orbit's Floquet stability, print a summary or one JSON object, and
+//! optionally write harmonics.csv, time_series.csv and SVG plots.
 
-use super::{load, Failure};
+use super::{load, multipliers_json, start, Failure, SolverArgs};
 use anyhow::Context;
 use hbal::report::{line_plot, Axis, Series};
+use hbal::stability::Floquet;
 use hbal::{HarmonicBalance, Solution};
 use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
 
-pub(crate) fn solve(
-    path: &Path,
-    method: Option<&str>,
-    harmonics: Option<usize>,
-    as_json: bool,
-    out: Option<&Path>,
-) -> Result<u8, Failure> {
-    let scene = load(path, method, harmonics)?;
+/// Options of `hbal solve` besides the solver overrides.
+pub(crate) struct SolveOptions<'a> {
+    pub(crate) start: Option<&'a Path>,
+    pub(crate) stability: bool,
+    pub(crate) json: bool,
+    pub(crate) out: Option<&'a Path>,
+}
+
+pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Result<u8, Failure> {
+    let as_json = opts.json;
+    let out = opts.out;
+    let scene = load(path, args)?;
+    let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
+    if let (Some(file), Some(s)) = (opts.start, &start) {
+        if let Some(w) = s.omega {
+            let here = scene.basis.omega();
+            if (w - here).abs() > 1e-9 * here {
+                eprintln!(
+                    "note: --start {} was computed at {w} rad/s; the scene is at {here} rad/s",
+                    file.display()
+                );
+            }
+        }
+        if s.dropped_orders > 0 {
+            eprintln!(
+                "note: --start {}: {} harmonic order(s) above H = {} dropped",
+                file.display(),
+                s.dropped_orders,
+                scene.basis.harmonics()
+            );
+        }
+    }
     if let Some(dir) = out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--out: cannot create {}", dir.display()))?;
     }
     let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
     let mut ws = hb.workspace();
-    let start = Instant::now();
-    let sol = scene.method.solve(&hb, None, &mut ws)?;
-    let solve_seconds = start.elapsed().as_secs_f64();
+    let started = Instant::now();
+    let sol = scene
+        .method
+        .solve(&hb, start.as_ref().map(|s| s.harmonics.as_slice()), &mut ws)?;
+    let solve_seconds = started.elapsed().as_secs_f64();
+    // Stability of a converged orbit (an unconverged iterate is no orbit to judge).
+    let started = Instant::now();
+    let stability: Option<Result<Floquet, String>> =
+        (opts.stability && sol.is_converged()).then(|| {
+            sol.stability(&scene.model)
+                .map_err(|e| e.to_string())
+                .and_then(|f| super::check_finite(&f).map(|_| f))
+        });
+    let stability_seconds = started.elapsed().as_secs_f64();
     let dofs: Vec<_> = sol
         .dof_names()
         .iter()
@@ -42,28 +79,46 @@ pub(crate) fn solve(
         })
         .collect();
     if as_json {
+        let stability_json = match &stability {
+            None => serde_json::Value::Null,
+            Some(Ok(f)) => json!({
+                "stable": f.is_stable(),
+                "max_abs": f.max_abs(),
+                "multipliers": multipliers_json(f),
+                "moduli": f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>(),
+                "neutral": f.neutral,
+                "orbit_correction": f.orbit_correction,
+                "polished": f.polished,
+                "seconds": stability_seconds,
+            }),
+            Some(Err(e)) => json!({ "error": e }),
+        };
         let doc = json!({
             "converged": sol.is_converged(),
             "termination": sol.termination.to_string(),
             "method": scene.method.name(),
             "iterations": sol.stats.iterations,
             "residual": sol.residual(),
+            "truncation_estimate": sol.truncation_estimate(),
             "fundamental_rad_s": sol.basis().omega(),
             "harmonics": sol.basis().harmonics(),
             "samples": sol.basis().samples(),
             "solve_seconds": solve_seconds,
+            "start": opts.start.map(|p| p.display().to_string()),
+            "stability": stability_json,
             "dofs": dofs,
             "history": sol.history,
         });
         say!("{doc}");
     } else {
         say!(
-            "{}: {} ({}) after {} iteration{}, relative residual {:.2e}, solve {:.3} ms",
+            "{}: {} ({}) after {} iteration{}{}, relative residual {:.2e}, solve {:.3} ms",
             scene.file,
             sol.termination,
             scene.method.name(),
             sol.stats.iterations,
             if sol.stats.iterations == 1 { "" } else { "s" },
+            if start.is_some() { " from --start" } else { "" },
             sol.residual(),
             solve_seconds * 1e3
         );
@@ -77,6 +132,36 @@ pub(crate) fn solve(
         for (i, name) in sol.dof_names().iter().enumerate() {
             say!("  max |q| {name}: {:.6e}", sol.max_abs(i));
         }
+        match &stability {
+            None if opts.stability => {
+                say!("  stability: not computed (the solve did not converge)")
+            }
+            None => {}
+            Some(Ok(f)) => say!(
+                "  stability: {}, max |μ| = {} ({} multiplier{}, {} neutral), orbit correction {:.1e}{}, {:.1} ms",
+                if f.is_stable() { "stable" } else { "unstable" },
+                super::modulus(f.max_abs()),
+                f.multipliers.len(),
+                if f.multipliers.len() == 1 { "" } else { "s" },
+                f.neutral,
+                f.orbit_correction,
+                if f.polished {
+                    ""
+                } else {
+                    " (shooting did not converge: multipliers along the HB orbit)"
+                },
+                stability_seconds * 1e3
+            ),
+            Some(Err(e)) => say!("  stability: failed: {e}"),
+        }
+    }
+    match &stability {
+        Some(Ok(f)) if !f.is_stable() => eprintln!(
+            "warning: the converged orbit is unstable (max |μ| = {:.6}): a time simulation would leave it",
+            f.max_abs()
+        ),
+        Some(Err(e)) => eprintln!("error: {}: stability computation failed: {e}", scene.file),
+        _ => {}
     }
     if let Some(dir) = out {
         write_outputs(dir, &sol)?;
@@ -87,7 +172,12 @@ pub(crate) fn solve(
             );
         }
     }
-    Ok(if sol.is_converged() { 0 } else { 1 })
+    let stability_failed = matches!(stability, Some(Err(_)));
+    Ok(if sol.is_converged() && !stability_failed {
+        0
+    } else {
+        1
+    })
 }
 
 fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {

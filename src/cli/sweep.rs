@@ -1,25 +1,55 @@
 //! `hbal sweep` (without `--parameter`): follow the frequency response from `--from` to `--to`
 //! through turning points by arclength continuation, with stability, and optionally write
-//! branch.csv and one frequency-response SVG per DOF.
+//! branch.csv and one frequency-response SVG per DOF. The first point starts from the linear
+//! solution or from a `--start` file.
 
-use super::{load, Failure};
+use super::{load, multipliers_json, start, Failure, SolverArgs};
 use anyhow::Context;
+use hbal::continuation::{Branch, BranchStop, Continuation};
 use hbal::HarmonicBasis;
+use num_complex::Complex64;
 use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
 
-pub(crate) fn sweep(
-    path: &Path,
-    from: f64,
+/// Options of a speed sweep besides the solver overrides.
+pub(crate) struct SweepOptions<'a> {
+    pub(crate) from: Option<f64>,
+    pub(crate) to: f64,
+    pub(crate) start: Option<&'a Path>,
+    pub(crate) stability: bool,
+    pub(crate) max_points: Option<usize>,
+    pub(crate) max_step: f64,
+    pub(crate) json: bool,
+    pub(crate) out: Option<&'a Path>,
+}
+
+/// The branch from `basis.omega()` to `to`, from the orbit `initial` if given.
+fn run(
+    continuation: &Continuation,
+    model: &hbal::Model,
+    basis: HarmonicBasis,
     to: f64,
-    as_json: bool,
-    out: Option<&Path>,
-    max_step: f64,
-) -> Result<u8, Failure> {
-    use hbal::continuation::{BranchStop, Continuation};
-    let scene = load(path, None, None)?;
+    initial: Option<&[Complex64]>,
+    progress: impl FnMut(f64),
+) -> hbal::Result<Branch> {
+    continuation.run_from(model, basis, to, initial, progress)
+}
+
+pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
+    let (to, as_json, out, max_step) = (opts.to, opts.json, opts.out, opts.max_step);
+    let scene = load(path, args)?;
     let unit = scene.speed_unit;
+    let per = scene.omega_per_speed;
+    let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
+    // Default start speed: the start file's, else the scene's.
+    let from = opts.from.unwrap_or_else(|| {
+        start
+            .as_ref()
+            .and_then(|s| s.omega)
+            .unwrap_or(scene.basis.omega())
+            / per
+    });
     for (name, v) in [("--from", from), ("--to", to)] {
         if !(v.is_finite() && v > 0.0) {
             return Err(
@@ -30,7 +60,18 @@ pub(crate) fn sweep(
     if !(max_step.is_finite() && max_step > 0.0) {
         return Err(anyhow::anyhow!("--max-step must be finite and > 0, got {max_step}").into());
     }
-    let per = scene.omega_per_speed;
+    if opts.max_points == Some(0) {
+        return Err(anyhow::anyhow!("--max-points must be at least 1").into());
+    }
+    if let (Some(file), Some(w)) = (opts.start, start.as_ref().and_then(|s| s.omega)) {
+        if (w - from * per).abs() > 1e-9 * w {
+            eprintln!(
+                "note: --start {} was computed at {} {unit}; the sweep starts at {from} {unit}",
+                file.display(),
+                w / per
+            );
+        }
+    }
     let basis = HarmonicBasis::new(from * per, scene.basis.harmonics())?
         .with_samples(scene.basis.samples())
         .with_context(|| scene.file.clone())?;
@@ -42,33 +83,71 @@ pub(crate) fn sweep(
     if as_json {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
-    let start = Instant::now();
+    let defaults = Continuation::default();
     let continuation = Continuation {
         max_step,
-        ..Continuation::default()
+        method: scene.method,
+        tolerance: args.tolerance.unwrap_or(defaults.tolerance),
+        max_points: opts.max_points.unwrap_or(defaults.max_points),
+        stability: if opts.stability {
+            defaults.stability
+        } else {
+            None
+        },
+        ..defaults
     };
-    let branch = continuation
-        .run(&scene.model, basis, to * per, |f| {
-            bar.set_position((f * 1000.0) as u64);
-        })
-        .with_context(|| scene.file.clone())?;
+    let started = Instant::now();
+    let branch = run(
+        &continuation,
+        &scene.model,
+        basis,
+        to * per,
+        start.as_ref().map(|s| s.harmonics.as_slice()),
+        |f| bar.set_position((f * 1000.0) as u64),
+    )
+    .map_err(|e| Failure {
+        code: super::exit_code(&e),
+        error: anyhow::Error::new(e).context(scene.file.clone()),
+    })?;
     bar.finish_and_clear();
-    let seconds = start.elapsed().as_secs_f64();
+    let seconds = started.elapsed().as_secs_f64();
     let speed = |omega: f64| omega / per;
+    // The library never gives a non-finite multiplier; should it, that is a failure, not `null`.
+    let broken = branch.points.iter().find_map(|p| {
+        p.floquet
+            .as_ref()
+            .and_then(|f| super::check_finite(f).err())
+            .map(|e| (p.omega, e))
+    });
     let n = scene.model.n_dofs();
+    let fold_speeds: Vec<f64> = branch
+        .points
+        .iter()
+        .filter(|p| p.fold)
+        .map(|p| speed(p.fold_omega.unwrap_or(p.omega)))
+        .collect();
     if as_json {
         let points: Vec<_> = branch
             .points
             .iter()
             .map(|p| {
+                let f = p.floquet.as_ref();
                 json!({
                     "speed": speed(p.omega),
                     "omega_rad_s": p.omega,
                     "stable": p.stable(),
                     "fold": p.fold,
+                    "fold_speed": if p.fold { p.fold_omega.map(speed) } else { None },
+                    "spurious_turn": p.spurious_turn,
                     "bifurcation": p.bifurcation.map(|b| format!("{b:?}")),
+                    "residual": p.residual,
+                    "truncation": p.truncation,
                     "max_abs": p.max_abs,
-                    "multipliers_abs": p.floquet.as_ref().map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
+                    "multipliers": f.map(multipliers_json),
+                    "multipliers_abs": f.map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
+                    "neutral": f.map(|f| f.neutral),
+                    "orbit_correction": f.map(|f| f.orbit_correction),
+                    "polished": f.map(|f| f.polished),
                     "harmonics": (0..n).map(|i| (0..=branch.harmonics).map(|k| {
                         let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
                         json!({"order": k, "cos": c, "sin": s})
@@ -81,10 +160,15 @@ pub(crate) fn sweep(
             json!({
                 "scene": scene.file,
                 "unit": unit,
+                "from": from,
+                "to": to,
+                "first_point": branch.start,
                 "stop": branch.stop.to_string(),
                 "reached": branch.stop == BranchStop::Reached,
                 "points": points,
                 "folds": branch.folds(),
+                "fold_speeds": fold_speeds,
+                "spurious_turns": branch.spurious_turns(),
                 "seconds": seconds,
                 "dofs": branch.dofs,
             })
@@ -95,31 +179,46 @@ pub(crate) fn sweep(
             .iter()
             .filter(|p| p.stable() == Some(false))
             .count();
+        let spurious = branch.spurious_turns();
         say!(
-            "{}: {} points from {from} to {to} {unit} in {:.1} ms: {}; {} folds, {} unstable points",
+            "{}: {} points from {from} to {to} {unit} in {:.1} ms: {}; {} fold{}, {} unstable point{}{}",
             scene.file,
             branch.points.len(),
             seconds * 1e3,
             branch.stop,
             branch.folds(),
-            unstable
+            if branch.folds() == 1 { "" } else { "s" },
+            unstable,
+            if unstable == 1 { "" } else { "s" },
+            if spurious > 0 {
+                format!(
+                    ", {spurious} spurious turn{} (corners or zig-zags the multipliers do not confirm)",
+                    if spurious == 1 { "" } else { "s" }
+                )
+            } else {
+                String::new()
+            }
         );
+        let failed_start = matches!(branch.stop, BranchStop::StartFailed { .. });
+        if !branch.start.is_empty() && branch.start != scene.method.name() && !failed_start {
+            say!("  first point: {}", branch.start);
+        }
         for p in branch
             .points
             .iter()
             .filter(|p| p.fold || p.bifurcation.is_some())
         {
+            let at = match (p.fold, p.fold_omega) {
+                (true, Some(w)) => format!("{:.6} {unit} (interpolated)", speed(w)),
+                _ => format!("{:.6} {unit}", speed(p.omega)),
+            };
             let what = match (p.fold, p.bifurcation) {
-                (true, Some(b)) => format!("fold, stability change ({b:?})"),
-                (true, None) => "fold".to_string(),
-                (false, Some(b)) => format!("stability change ({b:?})"),
+                (true, Some(b)) => format!("fold at {at}, stability change ({b:?})"),
+                (true, None) => format!("fold at {at}"),
+                (false, Some(b)) => format!("stability change ({b:?}) at {at}"),
                 _ => unreachable!("filtered"),
             };
-            say!(
-                "  {what} at {:.6} {unit}, max |q| = {:.6e}",
-                speed(p.omega),
-                p.max_abs[0]
-            );
+            say!("  {what}, max |q| = {:.6e}", p.max_abs[0]);
         }
     }
     if let Some(dir) = out {
@@ -141,6 +240,17 @@ pub(crate) fn sweep(
                 .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
             }
         }
+    }
+    if branch.stop != BranchStop::Reached {
+        eprintln!("error: {}: the branch stopped: {}", scene.file, branch.stop);
+    }
+    if let Some((omega, e)) = broken {
+        eprintln!(
+            "error: {}: stability at {} {unit}: {e}",
+            scene.file,
+            speed(omega)
+        );
+        return Ok(1);
     }
     Ok(if branch.stop == BranchStop::Reached {
         0

@@ -7,8 +7,12 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// CSV of a branch: parameter, stability, fold and bifurcation marks, `max|q|` per DOF, the
-/// amplitude `|Q_k|` of every DOF and order, and the Floquet multipliers' moduli.
-/// `parameter(p)` maps the point's swept parameter to the first column (e.g. Ω to rpm).
+/// amplitude `|Q_k|` of every DOF and order, the Floquet multipliers' moduli (`;`-separated,
+/// empty without stability), then the point's relative residual, its truncation estimate, the
+/// interpolated fold position (empty unless the point closes a fold) and whether a turning
+/// point of the discretised branch ends here that the multipliers do not confirm
+/// (`spurious_turn`). `parameter(p)` maps the point's swept parameter and the fold position to
+/// the parameter's unit (e.g. Ω to rpm).
 pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
     let mut s = String::new();
     let _ = write!(s, "{parameter_name},stable,fold,bifurcation");
@@ -20,7 +24,7 @@ pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64)
             let _ = write!(s, ",amp_{d}_{k}");
         }
     }
-    s.push_str(",multipliers_abs\n");
+    s.push_str(",multipliers_abs,residual,truncation,fold_speed,spurious_turn\n");
     let n = branch.dofs.len();
     for p in &branch.points {
         let stable = match p.stable() {
@@ -43,7 +47,18 @@ pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64)
             .iter()
             .flat_map(|f| f.multipliers.iter().map(|m| format!("{:.6e}", m.norm())))
             .collect();
-        let _ = writeln!(s, ",{}", mult.join(";"));
+        let fold_at = match (p.fold, p.fold_omega) {
+            (true, Some(w)) => format!("{:e}", parameter(w)),
+            _ => String::new(),
+        };
+        let _ = writeln!(
+            s,
+            ",{},{:e},{:e},{fold_at},{}",
+            mult.join(";"),
+            p.residual,
+            p.truncation,
+            p.spurious_turn
+        );
     }
     s
 }
