@@ -1,6 +1,9 @@
 //! The pseudo-arclength predictor–corrector (see the module documentation of
 //! [`continuation`](super)).
 
+// The corrector indexes several vectors in lock step.
+#![allow(clippy::needless_range_loop)]
+
 use super::point::NewPoint;
 use super::{Branch, BranchStop, Continuation};
 use crate::error::{Error, Result};
@@ -143,7 +146,11 @@ impl Continuation {
         let mut ws = hb.workspace();
         let layout = hb.layout();
         let m = layout.len();
-        let start = robust_start(&mut hb, &self.method, initial, self.tolerance, &mut ws)?;
+        let mut start = robust_start(&mut hb, &self.method, initial, self.tolerance, &mut ws)?;
+        if !start.solution.is_converged() && self.stability.is_some() {
+            // Last resort (the inner continuation runs without stability, so no recursion).
+            start = super::solve_robustly(model, basis, self)?;
+        }
         let mut branch = Branch {
             dofs: model.dof_names().to_vec(),
             harmonics: basis.harmonics(),

@@ -17,8 +17,10 @@
 mod arclength;
 mod parameter;
 mod point;
+mod speed_homotopy;
 
 pub use parameter::parameter_sweep;
+pub use speed_homotopy::solve_robustly;
 
 use crate::solve::{Method, Newton};
 use crate::stability::{Bifurcation, Floquet, FloquetOptions};

@@ -87,6 +87,10 @@ pub struct Floquet {
     /// orbit started from the HB state (still accurate to about the HB error).
     #[serde(default)]
     pub polished: bool,
+    /// The state `(q, q̇)` at `t = 0` of the orbit the multipliers belong to (the exact
+    /// periodic orbit when [`Floquet::polished`]).
+    #[serde(default)]
+    pub orbit_start: Vec<f64>,
     /// Integration steps (accepted, rejected and event re-steps) over all periods integrated.
     #[serde(default)]
     pub steps: usize,
@@ -271,6 +275,7 @@ impl FloquetOptions {
             neutral: all.ncols(),
             orbit_correction,
             polished,
+            orbit_start: x0,
             steps: flow.steps,
         })
     }
