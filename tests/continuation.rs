@@ -119,17 +119,58 @@ fn fold_locations_converge_with_harmonics() {
             branch
                 .points
                 .iter()
-                .filter(|p| p.fold)
-                .map(|p| p.omega)
+                .filter_map(|p| p.fold_omega)
                 .fold(0.0, f64::max),
         );
     }
-    // H = 1 misses the third harmonic (fold 7e-3 too low); from H = 3 on the interpolated fold
-    // sits at 2.21154.
+    // H = 1 misses the third harmonic (fold 7e-3 too low); from H = 5 on the located fold
+    // sits at 2.2115438 (the extended-system value for H = 7).
     let last = upper[upper.len() - 1];
     assert!((upper[0] - last).abs() > 5e-3, "{upper:?}");
-    for u in &upper[1..] {
-        assert!((u - last).abs() < 5e-6, "{upper:?}");
+    for u in &upper[2..] {
+        assert!((u - 2.2115438).abs() < 1e-6, "{upper:?}");
+    }
+}
+
+/// The fold positions: Duffing (m 1, d 0.02, k 1, α 1, F 0.1), H 7, located by the
+/// secant method on the tangent, within 1e-6 of the extended-system values 2.2115438 and
+/// 1.1701620, sweeping down 2.6 → 0.5 and up 0.5 → 3.0 in at most a few hundred points, each
+/// landing exactly on its end.
+#[test]
+fn duffing_folds_within_1e6_of_the_extended_system_both_ways() {
+    let model = Duffing::default().model().unwrap();
+    for (from, to) in [(2.6, 0.5), (0.5, 3.0)] {
+        let branch = Continuation::default()
+            .run(&model, HarmonicBasis::new(from, 7).unwrap(), to, |_| {})
+            .unwrap();
+        assert_eq!(branch.stop, BranchStop::Reached);
+        assert!(branch.points.len() <= 300, "{} points", branch.points.len());
+        assert_eq!(branch.points.last().unwrap().omega, to);
+        let mut folds: Vec<f64> = branch.points.iter().filter_map(|p| p.fold_omega).collect();
+        folds.sort_by(f64::total_cmp);
+        assert_eq!(folds.len(), 2, "{folds:?}");
+        assert!((folds[0] - 1.1701620).abs() < 1e-6, "{folds:?}");
+        assert!((folds[1] - 2.2115438).abs() < 1e-6, "{folds:?}");
+        assert_eq!(branch.spurious_turns(), 0);
+    }
+}
+
+/// A non-smooth branch (the backlash pair, H 32): exactly two real folds whatever the step,
+/// the zig-zags of the discretised branch reported as spurious turns.
+#[test]
+fn backlash_branch_has_two_folds_at_every_step_size() {
+    let model = hbal::catalog::GearBacklash::default().model().unwrap();
+    for max_step in [0.5, 0.1, 0.03] {
+        let branch = Continuation {
+            max_step,
+            ..Continuation::default()
+        }
+        .run(&model, HarmonicBasis::new(0.4, 32).unwrap(), 1.6, |_| {})
+        .unwrap();
+        let folds: Vec<f64> = branch.points.iter().filter_map(|p| p.fold_omega).collect();
+        assert_eq!(folds.len(), 2, "max_step {max_step}: {folds:?}");
+        assert!((folds[0] - 0.8352).abs() < 1e-3, "{folds:?}");
+        assert!((folds[1] - 0.5425).abs() < 2e-3, "{folds:?}");
     }
 }
 
