@@ -260,3 +260,37 @@ fn stuck_continuation_keeps_its_branch() {
         .to_string()
         .contains("step size under its minimum"));
 }
+
+/// The symmetric backlash chain: along its symmetric branch a real multiplier crosses +1
+/// without a turn near the reference's W = 1.3455289 (exact orbits); the sweep labels it a
+/// branch point, not a fold.
+#[test]
+#[ignore = "12 s in a debug build; CI runs it in release (.ci/run)"]
+fn chain_symmetry_breaking_is_a_branch_point() {
+    let scene = hbal::scene::Scene::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/scenes/chain_backlash.toml"),
+    )
+    .unwrap();
+    let branch = Continuation {
+        method: scene.method,
+        ..Continuation::default()
+    }
+    .run(
+        &scene.model,
+        HarmonicBasis::new(1.3, 64).unwrap(),
+        1.4,
+        |_| {},
+    )
+    .unwrap();
+    assert_eq!(branch.stop, BranchStop::Reached);
+    assert_eq!(branch.folds(), 0);
+    let changes: Vec<_> = branch
+        .points
+        .iter()
+        .filter_map(|p| p.bifurcation.map(|b| (p.omega, b)))
+        .collect();
+    assert_eq!(changes.len(), 1, "{changes:?}");
+    assert_eq!(changes[0].1, Bifurcation::BranchPoint);
+    assert!((changes[0].0 - 1.3455289).abs() < 3e-3, "{changes:?}");
+}

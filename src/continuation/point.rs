@@ -18,6 +18,7 @@
 use super::{Branch, BranchPoint, Continuation};
 use crate::model::Model;
 use crate::solution::Solution;
+use crate::stability::Bifurcation;
 use crate::HarmonicBasis;
 use num_complex::Complex64;
 
@@ -117,6 +118,12 @@ pub(super) fn classify_turns(branch: &mut Branch) {
     for c in clusters {
         let turns: Vec<usize> = c.iter().filter(|e| e.1).map(|e| e.0).collect();
         if turns.is_empty() {
+            // A multiplier through +1 without a turn: a branch point.
+            for &(i, _) in &c {
+                if pts[i].bifurcation == Some(Bifurcation::Fold) {
+                    pts[i].bifurcation = Some(Bifurcation::BranchPoint);
+                }
+            }
             continue;
         }
         let before = c[0].0.saturating_sub(2);

@@ -67,6 +67,10 @@ pub enum Bifurcation {
     Fold,
     /// Real multiplier near −1.
     PeriodDoubling,
+    /// A real multiplier through +1 where the branch does not turn: a symmetry-breaking
+    /// (pitchfork) or transcritical branch point, where another branch crosses. Set by the
+    /// continuation, which sees the branch's geometry.
+    BranchPoint,
     /// Complex pair on the unit circle.
     NeimarkSacker,
 }
