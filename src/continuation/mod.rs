@@ -8,7 +8,7 @@
 //! `[[R_x s_x, R_Ω s_Ω], [t_iᵀ]] δ = -[R, t_iᵀ (y - y_p)]`,
 //!
 //! with the exact AFT Jacobian `R_x` and the analytic `R_Ω`
-//! ([`HarmonicBalance::omega_derivative_real_into`]). The new tangent solves the same matrix
+//! ([`HarmonicBalance::omega_derivative_real_into`](crate::HarmonicBalance::omega_derivative_real_into)). The new tangent solves the same matrix
 //! with right-hand side `(0, 1)`, which keeps its orientation. A turning point (fold) lies where
 //! the Ω-component of the tangent changes sign. The step grows by 1.5 after quick corrector
 //! convergence, shrinks by 0.5 after a failure, and the branch stops with a reason (and all
