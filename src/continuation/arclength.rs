@@ -96,6 +96,17 @@ struct Scales {
     ext: f64,
 }
 
+impl Scales {
+    /// The predictor `(x, Ω) + s t` in the scaled unknowns: writes `x_p`, returns `Ω_p`.
+    fn predict(&self, x: &[f64], omega: f64, t: &[f64], s: f64, xp: &mut [f64]) -> f64 {
+        let m = x.len();
+        for i in 0..m {
+            xp[i] = x[i] + s * t[i] * self.sx;
+        }
+        omega + s * t[m] * self.so
+    }
+}
+
 impl Continuation {
     /// Defaults.
     pub fn new() -> Self {
@@ -213,11 +224,7 @@ impl Continuation {
         let mut land_row = vec![0.0; m + 1];
         land_row[m] = 1.0;
         while branch.points.len() < self.max_points {
-            // Predictor.
-            for i in 0..m {
-                xp[i] = x[i] + step * t[i] * sc.sx;
-            }
-            let op = omega + step * t[m] * sc.so;
+            let op = sc.predict(&x, omega, &t, step, &mut xp);
             x_new.copy_from_slice(&xp);
             let mut o_new = op;
             let target = Target {
@@ -402,10 +409,7 @@ impl Continuation {
             if !s.is_finite() {
                 break;
             }
-            for i in 0..m {
-                xp[i] = x[i] + s * t0[i] * sc.sx;
-            }
-            let op = omega + s * t0[m] * sc.so;
+            let op = sc.predict(x, omega, t0, s, &mut xp);
             xc.copy_from_slice(&xp);
             let mut oc = op;
             let target = Target {
