@@ -95,15 +95,17 @@ impl<'m> HarmonicBalance<'m> {
             });
         }
         let mut f_ext = vec![Complex64::default(); (h + 1) * n];
+        let nu = basis.subharmonic();
         for l in model.loads() {
-            if l.order > h {
+            // Order k of the shaft is harmonic νk of the fundamental Ω/ν.
+            if l.order * nu > h {
                 return Err(Error::LoadOrderTooHigh {
                     dof: model.dof_names()[l.dof].clone(),
                     order: l.order,
-                    harmonics: h,
+                    harmonics: h / nu,
                 });
             }
-            f_ext[l.order * n + l.dof] += crate::harmonic::from_cos_sin(l.cos, l.sin);
+            f_ext[l.order * nu * n + l.dof] += crate::harmonic::from_cos_sin(l.cos, l.sin);
         }
         let mut f_split = f_ext.clone();
         for e in model.elements() {
@@ -115,7 +117,8 @@ impl<'m> HarmonicBalance<'m> {
         let (d0, k0) = (model.d0(), model.k0());
         let z = DynamicStiffness::new(&basis, model.mass(), &d0, &k0)?;
         let samples = basis.samples();
-        let thetas: Vec<f64> = (0..samples).map(|j| basis.theta(j)).collect();
+        // The laws see the shaft angle Ωt = ν θ_j.
+        let thetas: Vec<f64> = (0..samples).map(|j| basis.shaft_angle(j)).collect();
         let active = model
             .elements()
             .iter()
@@ -126,7 +129,8 @@ impl<'m> HarmonicBalance<'m> {
                     .law()
                     .time_breakpoints()
                     .iter()
-                    .filter_map(|&b| {
+                    .flat_map(|&b| (0..nu).map(move |r| (b + TAU * r as f64) / nu as f64))
+                    .filter_map(|b| {
                         let x = b / TAU * samples as f64;
                         let j = x.round();
                         ((x - j).abs() < 1e-9).then_some(j as usize % samples)
@@ -247,7 +251,7 @@ impl<'m> HarmonicBalance<'m> {
         ws: &mut AftBuffers,
     ) -> Result<()> {
         let (n, h) = (self.model.n_dofs(), self.basis.harmonics());
-        let omega = self.basis.omega();
+        let omega = self.basis.fundamental();
         out.fill(Complex64::default());
         for act in &self.active {
             let e = &self.model.elements()[act.index];
@@ -309,7 +313,7 @@ impl<'m> HarmonicBalance<'m> {
     }
 
     /// `out ← ∂R/∂Ω` at `x` (real layout), analytic: `(dZ_k/dΩ) Q_k` with
-    /// `dZ_k/dΩ = -2k²Ω M + i k D0`, plus the AFT of `(∂f/∂u̇ - d0) u̇/Ω` per element (the rest
+    /// `dZ_k/dΩ = -2(k/ν)²Ω M + i (k/ν) D0` (harmonic k oscillates at kΩ/ν), plus the AFT of `(∂f/∂u̇ - d0) u̇/Ω` per element (the rest
     /// depends on Ω only through `u̇ = Σ i kΩ U_k e^{ikθ}`). For continuation in Ω.
     pub fn omega_derivative_real_into(
         &self,
@@ -320,10 +324,11 @@ impl<'m> HarmonicBalance<'m> {
         let layout = self.layout();
         let (n, h) = (layout.n, layout.h);
         let omega = self.basis.omega();
+        let nu = self.basis.subharmonic() as f64;
         layout.unpack(x, &mut ws.q);
         let m = self.model.mass();
         for k in 0..=h {
-            let kf = k as f64;
+            let kf = k as f64 / nu;
             for i in 0..n {
                 let mut acc = Complex64::default();
                 for j in 0..n {
@@ -373,8 +378,7 @@ impl<'m> HarmonicBalance<'m> {
     /// Moves the discretisation to a new fundamental Ω (rebuilds and factors `Z_k`); for
     /// sweeps. Errors as [`HarmonicBalance::new`] on a singular `Z_k`.
     pub fn set_omega(&mut self, omega: f64) -> Result<()> {
-        let basis = HarmonicBasis::new(omega, self.basis.harmonics())?
-            .with_samples(self.basis.samples())?;
+        let basis = self.basis.with_omega(omega)?;
         self.z = DynamicStiffness::new(&basis, self.model.mass(), &self.d0, &self.k0)?;
         self.basis = basis;
         Ok(())
@@ -383,7 +387,7 @@ impl<'m> HarmonicBalance<'m> {
     /// `u(θ_j)`, `u̇(θ_j)` of element `e` at the samples into `b.u`, `b.du` (its local
     /// harmonics `U_k = w·Q_k` in `b.uk`).
     fn element_samples(&self, e: &crate::Element, q: &[Complex64], b: &mut AftBuffers) {
-        let (n, omega) = (self.model.n_dofs(), self.basis.omega());
+        let (n, omega) = (self.model.n_dofs(), self.basis.fundamental());
         for (k, uk) in b.uk.iter_mut().enumerate() {
             *uk = e.gather(&q[k * n..(k + 1) * n]);
         }

@@ -173,16 +173,17 @@ impl Solution {
         cos_sin(self.harmonic(dof, k))
     }
 
-    /// `q_dof(θ)` at angle `θ = Ω t`. Panics as [`Solution::harmonic`].
+    /// `q_dof(θ)` at angle `θ = (Ω/ν) t` of the fundamental (`Ω t` unless the basis is
+    /// period-multiplied). Panics as [`Solution::harmonic`].
     pub fn displacement(&self, dof: usize, theta: f64) -> f64 {
         (0..=self.basis.harmonics())
             .map(|k| (self.harmonic(dof, k) * Complex64::from_polar(1.0, k as f64 * theta)).re)
             .sum()
     }
 
-    /// `q̇_dof(θ)` at angle `θ = Ω t`.
+    /// `q̇_dof(θ)` at angle `θ = (Ω/ν) t`.
     pub fn velocity(&self, dof: usize, theta: f64) -> f64 {
-        let w = self.basis.omega();
+        let w = self.basis.fundamental();
         (1..=self.basis.harmonics())
             .map(|k| {
                 (self.harmonic(dof, k)

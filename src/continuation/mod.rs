@@ -15,9 +15,11 @@
 //! points so far) when it falls under its minimum.
 
 mod arclength;
+mod bordered;
 mod parameter;
 mod point;
 mod speed_homotopy;
+mod switch;
 
 pub use parameter::parameter_sweep;
 pub use speed_homotopy::solve_robustly;
@@ -105,6 +107,11 @@ pub enum BranchStop {
         /// Why.
         reason: String,
     },
+    /// Branch switching found no new branch at the bifurcation.
+    SwitchFailed {
+        /// Why.
+        reason: String,
+    },
     /// The first point did not converge.
     StartFailed {
         /// The solver's termination.
@@ -123,6 +130,7 @@ impl std::fmt::Display for BranchStop {
             BranchStop::Singular { omega } => {
                 write!(f, "singular bordered system near Ω = {omega}")
             }
+            BranchStop::SwitchFailed { reason } => write!(f, "no branch switch: {reason}"),
             BranchStop::StabilityFailed { omega, reason } => {
                 write!(f, "stability failed near Ω = {omega}: {reason}")
             }
@@ -149,6 +157,13 @@ pub struct Branch {
     pub dofs: Vec<String>,
     /// H.
     pub harmonics: usize,
+    /// The period multiple ν of the orbits (1; 2 on a period-doubled branch): harmonic k
+    /// oscillates at kΩ/ν.
+    #[serde(default = "one")]
+    pub subharmonic: usize,
+    /// Where a secondary branch comes from (`None` for a branch started from a solve).
+    #[serde(default)]
+    pub origin: Option<Origin>,
     /// The points in branch order.
     pub points: Vec<BranchPoint>,
     /// How the first point was found (see [`robust_start`](crate::solve::robust_start)).
@@ -158,7 +173,37 @@ pub struct Branch {
     pub stop: BranchStop,
 }
 
+fn one() -> usize {
+    1
+}
+
+/// Where a secondary branch leaves the branch it was switched from.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Origin {
+    /// The bifurcation: a branch point or a period doubling.
+    pub bifurcation: Bifurcation,
+    /// Its Ω, located on the parent branch (to about 1e-9 relative).
+    pub omega: f64,
+    /// The index of the parent branch's point just after it.
+    pub parent_point: usize,
+    /// Which side of the parent branch (+1 or -1 along the null vector).
+    pub side: i8,
+}
+
 impl Branch {
+    /// An empty branch of `model` on `basis` whose first point was found by `start`.
+    pub(crate) fn new(model: &crate::Model, basis: crate::HarmonicBasis, start: String) -> Self {
+        Self {
+            dofs: model.dof_names().to_vec(),
+            harmonics: basis.harmonics(),
+            subharmonic: basis.subharmonic(),
+            origin: None,
+            points: Vec::new(),
+            start,
+            stop: BranchStop::Reached,
+        }
+    }
+
     /// Number of (confirmed) turning points.
     pub fn folds(&self) -> usize {
         self.points.iter().filter(|p| p.fold).count()

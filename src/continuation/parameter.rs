@@ -53,24 +53,12 @@ pub fn parameter_sweep(
                 if let Some(b) = branch.as_mut() {
                     b.start = start.how;
                 } else {
-                    branch = Some(Branch {
-                        dofs: model.dof_names().to_vec(),
-                        harmonics: basis.harmonics(),
-                        points: Vec::new(),
-                        start: start.how,
-                        stop: BranchStop::Reached,
-                    });
+                    branch = Some(Branch::new(&model, basis, start.how));
                 }
                 start.solution
             }
         };
-        let b = branch.get_or_insert_with(|| Branch {
-            dofs: model.dof_names().to_vec(),
-            harmonics: basis.harmonics(),
-            points: Vec::new(),
-            start: String::new(),
-            stop: BranchStop::Reached,
-        });
+        let b = branch.get_or_insert_with(|| Branch::new(&model, basis, String::new()));
         if !sol.is_converged() {
             b.stop = if i == 0 {
                 BranchStop::StartFailed {
@@ -87,8 +75,6 @@ pub fn parameter_sweep(
             harmonics: sol.harmonics().to_vec(),
             parameter: p,
             residual: sol.residual(),
-            turn: false,
-            turn_omega: None,
         };
         if let Some(reason) = cont.push_point(b, &model, point) {
             b.stop = BranchStop::StabilityFailed {

@@ -28,10 +28,6 @@ pub(super) struct NewPoint {
     pub harmonics: Vec<Complex64>,
     pub parameter: f64,
     pub residual: f64,
-    /// The tangent's Ω component changed sign since the previous point.
-    pub turn: bool,
-    /// The turning point's Ω, interpolated.
-    pub turn_omega: Option<f64>,
 }
 
 impl Continuation {
@@ -79,10 +75,11 @@ impl Continuation {
             residual: p.residual,
             truncation,
             floquet,
-            // Tentative: [`classify_turns`] decides once the neighbours are known.
-            fold: p.turn,
+            // Set by the caller for a turn, then [`classify_turns`] decides once the
+            // neighbours are known.
+            fold: false,
             spurious_turn: false,
-            fold_omega: p.turn_omega,
+            fold_omega: None,
             bifurcation,
         });
         failure

@@ -1,9 +1,15 @@
-//! The truncated Fourier basis: fundamental Ω, H harmonics, N time samples.
+//! The truncated Fourier basis: excitation frequency Ω, period multiple ν (fundamental Ω/ν),
+//! H harmonics, N time samples.
 
 use crate::error::{check_positive, Error, Result};
 use std::f64::consts::TAU;
 
-/// Fundamental angular frequency Ω, number of harmonics H and time samples N.
+/// Excitation angular frequency Ω, number of harmonics H and time samples N; the period
+/// multiple ν (1 by default) sets the fundamental Ω/ν and the period νT.
+///
+/// A basis with ν = 2 represents the period-2 orbits born at a period doubling: the Fourier
+/// series runs over `(Ω/2) t`, the force laws still see the shaft angle `θ = Ω t`, and a load of
+/// order k sits at harmonic `2k`.
 ///
 /// The default N is the smallest power of two `>= 4H + 1`: a cubic force is then free of
 /// aliasing in the kept harmonics, the FFT is fastest, and the jumps of a rectangular mesh
@@ -20,12 +26,21 @@ pub struct HarmonicBasis {
     omega: f64,
     harmonics: usize,
     samples: usize,
+    #[serde(default = "one")]
+    subharmonic: usize,
+}
+
+fn one() -> usize {
+    1
 }
 
 impl HarmonicBasis {
     /// Largest accepted H (65 536; the dense Jacobian of Newton and Broyden has a lower limit,
     /// see [`crate::solve::Newton`]).
     pub const MAX_HARMONICS: usize = 1 << 16;
+
+    /// Largest period multiple ν.
+    pub const MAX_SUBHARMONIC: usize = 64;
 
     /// Ω in rad/s (finite, > 0) and H harmonics (0 = static only, at most
     /// [`HarmonicBasis::MAX_HARMONICS`]); N by default.
@@ -44,6 +59,39 @@ impl HarmonicBasis {
             omega,
             harmonics,
             samples,
+            subharmonic: 1,
+        })
+    }
+
+    /// The same basis at another Ω (H, N and ν kept).
+    pub fn with_omega(mut self, omega: f64) -> Result<Self> {
+        check_positive("harmonic basis", "omega", omega)?;
+        self.omega = omega;
+        Ok(self)
+    }
+
+    /// The basis of the period-doubled orbits: ν, H and N doubled, so that the harmonics of
+    /// this basis are the even harmonics of the new one, resolved as finely.
+    ///
+    /// ```
+    /// use hbal::HarmonicBasis;
+    /// let b = HarmonicBasis::new(2.0, 32).unwrap().doubled().unwrap();
+    /// assert_eq!((b.subharmonic(), b.harmonics(), b.samples()), (2, 64, 512));
+    /// assert_eq!(b.fundamental(), 1.0);
+    /// ```
+    pub fn doubled(self) -> Result<Self> {
+        if self.subharmonic >= Self::MAX_SUBHARMONIC {
+            return Err(Error::invalid(
+                "harmonic basis",
+                "period multiple",
+                (2 * self.subharmonic) as f64,
+                format!("<= {}", Self::MAX_SUBHARMONIC),
+            ));
+        }
+        let b = Self::new(self.omega, 2 * self.harmonics)?.with_samples(2 * self.samples)?;
+        Ok(Self {
+            subharmonic: 2 * self.subharmonic,
+            ..b
         })
     }
 
@@ -59,9 +107,19 @@ impl HarmonicBasis {
         Ok(self)
     }
 
-    /// Ω in rad/s.
+    /// Ω in rad/s: the excitation (shaft) frequency, the swept parameter.
     pub fn omega(&self) -> f64 {
         self.omega
+    }
+
+    /// The period multiple ν (1 for orbits with the excitation's period).
+    pub fn subharmonic(&self) -> usize {
+        self.subharmonic
+    }
+
+    /// The fundamental Ω/ν of the Fourier series in rad/s: harmonic k oscillates at kΩ/ν.
+    pub fn fundamental(&self) -> f64 {
+        self.omega / self.subharmonic as f64
     }
 
     /// H.
@@ -74,14 +132,20 @@ impl HarmonicBasis {
         self.samples
     }
 
-    /// Period T = 2π/Ω in s.
+    /// Period νT = 2πν/Ω of the orbits in s.
     pub fn period(&self) -> f64 {
-        TAU / self.omega
+        TAU / self.fundamental()
     }
 
-    /// Angle θ_j = 2π j / N of sample j.
+    /// Angle θ_j = 2π j / N of sample j, on the fundamental ((Ω/ν) t).
     #[inline]
     pub fn theta(&self, j: usize) -> f64 {
         TAU * j as f64 / self.samples as f64
+    }
+
+    /// The shaft angle `Ω t` at sample j, reduced to [0, 2π): what force laws see.
+    #[inline]
+    pub fn shaft_angle(&self, j: usize) -> f64 {
+        TAU * ((j * self.subharmonic) % self.samples) as f64 / self.samples as f64
     }
 }

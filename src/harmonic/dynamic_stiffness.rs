@@ -29,7 +29,7 @@ impl DynamicStiffness {
         let mut matrices = Vec::with_capacity(basis.harmonics() + 1);
         let mut factors = Vec::with_capacity(basis.harmonics() + 1);
         for k in 0..=basis.harmonics() {
-            let w = k as f64 * basis.omega();
+            let w = k as f64 * basis.fundamental();
             let z = DMatrix::from_fn(n, n, |i, j| {
                 Complex64::new(k0[(i, j)] - w * w * m[(i, j)], w * d0[(i, j)])
             });

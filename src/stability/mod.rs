@@ -225,7 +225,10 @@ impl FloquetOptions {
             for i in 0..s2 {
                 y[s2 + i * s2 + i] = 1.0;
             }
-            flow.period(&mut y, &opts, &mut stepper)?;
+            // A period-multiplied orbit: ν excitation periods (the system is T-periodic).
+            for _ in 0..solution.basis().subharmonic() {
+                flow.period(&mut y, &opts, &mut stepper)?;
+            }
             phi.copy_from_slice(&y[s2..]);
             if phi.iter().any(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {
@@ -315,7 +318,10 @@ fn scales(model: &Model, solution: &Solution) -> (f64, f64) {
     for e in model.elements() {
         let (mut km, mut dm) = (0.0_f64, 0.0_f64);
         for j in 0..samples {
-            let theta = std::f64::consts::TAU * j as f64 / samples as f64;
+            // The shaft angle Ωt at sample j (ν times the fundamental's).
+            let theta = std::f64::consts::TAU
+                * ((j * solution.basis().subharmonic()) % samples) as f64
+                / samples as f64;
             for i in 0..n {
                 q[i] = series[i][j];
                 v[i] = rates[i][j];
@@ -352,7 +358,7 @@ fn scales(model: &Model, solution: &Solution) -> (f64, f64) {
 fn sampled_orbit(solution: &Solution, samples: usize) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
     let n = solution.dof_names().len();
     let h = solution.basis().harmonics();
-    let omega = solution.basis().omega();
+    let omega = solution.basis().fundamental();
     let harmonics = solution.harmonics();
     let mut q = vec![vec![0.0; samples]; n];
     let mut v = vec![vec![0.0; samples]; n];
