@@ -84,6 +84,11 @@ enum Command {
         /// Write branch.csv and frequency_response.svg into this directory.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Also follow every branch that leaves the swept one: at a branch point (symmetry
+        /// breaking) both new branches, at a period doubling the period-2 orbits (harmonics
+        /// of half the speed). Needs the stability; writes branch_1.csv, ... with --out.
+        #[arg(long)]
+        all_branches: bool,
         /// Largest continuation step (scaled arclength; smaller gives more points).
         #[arg(long, default_value_t = 0.5)]
         max_step: f64,
@@ -144,9 +149,13 @@ fn main() -> ExitCode {
             json,
             out,
             max_step,
+            all_branches,
             parameter,
             points,
         } => match parameter {
+            Some(_) if all_branches => Err(cli::Failure::from(anyhow::anyhow!(
+                "--all-branches follows branches in the speed; it does not apply to --parameter sweeps"
+            ))),
             Some(name) => cli::parameter_sweep::parameter_sweep(
                 &scene,
                 &name,
@@ -173,6 +182,7 @@ fn main() -> ExitCode {
                     max_step,
                     json,
                     out: out.as_deref(),
+                    all_branches,
                 },
             ),
         },

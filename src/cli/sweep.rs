@@ -5,7 +5,7 @@
 
 use super::{load, multipliers_json, start, Failure, SolverArgs};
 use anyhow::Context;
-use hbal::continuation::{Branch, BranchStop, Continuation};
+use hbal::continuation::{Branch, BranchPoint, BranchStop, Continuation};
 use hbal::HarmonicBasis;
 use num_complex::Complex64;
 use serde_json::json;
@@ -22,6 +22,8 @@ pub(crate) struct SweepOptions<'a> {
     pub(crate) max_step: f64,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
+    /// Switch to the branches leaving the main one at its branch points and period doublings.
+    pub(crate) all_branches: bool,
 }
 
 /// The branch from `basis.omega()` to `to`, from the orbit `initial` if given.
@@ -34,6 +36,58 @@ fn run(
     progress: impl FnMut(f64),
 ) -> hbal::Result<Branch> {
     continuation.run_from(model, basis, to, initial, progress)
+}
+
+/// One point of a branch as JSON; harmonic k of a branch with period multiple ν is shaft
+/// order k/ν.
+fn point_json(p: &BranchPoint, branch: &Branch, speed: impl Fn(f64) -> f64) -> serde_json::Value {
+    let n = branch.dofs.len();
+    let nu = branch.subharmonic.max(1);
+    let f = p.floquet.as_ref();
+    json!({
+        "speed": speed(p.omega),
+        "omega_rad_s": p.omega,
+        "stable": p.stable(),
+        "fold": p.fold,
+        "fold_speed": if p.fold { p.fold_omega.map(&speed) } else { None },
+        "spurious_turn": p.spurious_turn,
+        "bifurcation": p.bifurcation.map(|b| format!("{b:?}")),
+        "bifurcation_speed": p.bifurcation_omega.map(&speed),
+        "residual": p.residual,
+        "truncation": p.truncation,
+        "max_abs": p.max_abs,
+        "multipliers": f.map(multipliers_json),
+        "multipliers_abs": f.map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
+        "neutral": f.map(|f| f.neutral),
+        "orbit_correction": f.map(|f| f.orbit_correction),
+        "polished": f.map(|f| f.polished),
+        "harmonics": (0..n).map(|i| (0..=branch.harmonics).map(|k| {
+            let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
+            if nu == 1 {
+                json!({"order": k, "cos": c, "sin": s})
+            } else {
+                json!({"harmonic": k, "order": k as f64 / nu as f64, "cos": c, "sin": s})
+            }
+        }).collect::<Vec<_>>()).collect::<Vec<_>>(),
+    })
+}
+
+/// A secondary branch as JSON: where it leaves the main branch, its period multiple, its
+/// points and why it ended.
+fn secondary_json(b: &Branch, speed: impl Fn(f64) -> f64 + Copy) -> serde_json::Value {
+    let origin = b.origin.as_ref();
+    json!({
+        "bifurcation": origin.map(|o| format!("{:?}", o.bifurcation)),
+        "from_speed": origin.map(|o| speed(o.omega)),
+        "from_omega_rad_s": origin.map(|o| o.omega),
+        "side": origin.map(|o| o.side),
+        "parent_point": origin.map(|o| o.parent_point),
+        "period_multiple": b.subharmonic,
+        "stop": b.stop.to_string(),
+        "reached": b.stop == BranchStop::Reached,
+        "folds": b.folds(),
+        "points": b.points.iter().map(|p| point_json(p, b, speed)).collect::<Vec<_>>(),
+    })
 }
 
 pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
@@ -59,6 +113,12 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     }
     if !(max_step.is_finite() && max_step > 0.0) {
         return Err(anyhow::anyhow!("--max-step must be finite and > 0, got {max_step}").into());
+    }
+    if opts.all_branches && !opts.stability {
+        return Err(anyhow::anyhow!(
+            "--all-branches needs the stability of the points (drop --no-stability): branch points and period doublings are found from the Floquet multipliers"
+        )
+        .into());
     }
     if opts.max_points == Some(0) {
         return Err(anyhow::anyhow!("--max-points must be at least 1").into());
@@ -109,6 +169,18 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         code: super::exit_code(&e),
         error: anyhow::Error::new(e).context(scene.file.clone()),
     })?;
+    let (lo, hi) = (from.min(to) * per, from.max(to) * per);
+    let secondary = if opts.all_branches {
+        bar.set_message("switching branches");
+        continuation
+            .switch_branches(&scene.model, basis, &branch, lo, hi)
+            .map_err(|e| Failure {
+                code: super::exit_code(&e),
+                error: anyhow::Error::new(e).context(scene.file.clone()),
+            })?
+    } else {
+        Vec::new()
+    };
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
     let speed = |omega: f64| omega / per;
@@ -119,7 +191,6 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             .and_then(|f| super::check_finite(f).err())
             .map(|e| (p.omega, e))
     });
-    let n = scene.model.n_dofs();
     let fold_speeds: Vec<f64> = branch
         .points
         .iter()
@@ -130,30 +201,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         let points: Vec<_> = branch
             .points
             .iter()
-            .map(|p| {
-                let f = p.floquet.as_ref();
-                json!({
-                    "speed": speed(p.omega),
-                    "omega_rad_s": p.omega,
-                    "stable": p.stable(),
-                    "fold": p.fold,
-                    "fold_speed": if p.fold { p.fold_omega.map(speed) } else { None },
-                    "spurious_turn": p.spurious_turn,
-                    "bifurcation": p.bifurcation.map(|b| format!("{b:?}")),
-                    "residual": p.residual,
-                    "truncation": p.truncation,
-                    "max_abs": p.max_abs,
-                    "multipliers": f.map(multipliers_json),
-                    "multipliers_abs": f.map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
-                    "neutral": f.map(|f| f.neutral),
-                    "orbit_correction": f.map(|f| f.orbit_correction),
-                    "polished": f.map(|f| f.polished),
-                    "harmonics": (0..n).map(|i| (0..=branch.harmonics).map(|k| {
-                        let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
-                        json!({"order": k, "cos": c, "sin": s})
-                    }).collect::<Vec<_>>()).collect::<Vec<_>>(),
-                })
-            })
+            .map(|p| point_json(p, &branch, speed))
             .collect();
         say!(
             "{}",
@@ -171,6 +219,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 "spurious_turns": branch.spurious_turns(),
                 "seconds": seconds,
                 "dofs": branch.dofs,
+                "branches": secondary.iter().map(|b| secondary_json(b, speed)).collect::<Vec<_>>(),
             })
         );
     } else {
@@ -208,8 +257,9 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             .iter()
             .filter(|p| p.fold || p.bifurcation.is_some())
         {
-            let at = match (p.fold, p.fold_omega) {
-                (true, Some(w)) => format!("{:.6} {unit} (interpolated)", speed(w)),
+            let at = match (p.fold, p.fold_omega, p.bifurcation_omega) {
+                (true, Some(w), _) => format!("{:.7} {unit} (interpolated)", speed(w)),
+                (false, _, Some(w)) => format!("{:.7} {unit} (located)", speed(w)),
                 _ => format!("{:.6} {unit}", speed(p.omega)),
             };
             let what = match (p.fold, p.bifurcation) {
@@ -220,6 +270,9 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             };
             say!("  {what}, max |q| = {:.6e}", p.max_abs[0]);
         }
+        for b in &secondary {
+            say!("  {}", secondary_line(b, unit, speed));
+        }
     }
     if let Some(dir) = out {
         std::fs::create_dir_all(dir)?;
@@ -227,11 +280,18 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             dir.join("branch.csv"),
             hbal::report::branch_csv(&branch, unit, speed),
         )?;
+        for (i, b) in secondary.iter().enumerate() {
+            std::fs::write(
+                dir.join(format!("branch_{}.csv", i + 1)),
+                hbal::report::branch_csv(b, unit, speed),
+            )?;
+        }
         if branch.points.len() >= 2 {
+            let all: Vec<&Branch> = std::iter::once(&branch).chain(&secondary).collect();
             for (i, dof) in branch.dofs.iter().enumerate() {
-                hbal::report::branch_plot(
+                hbal::report::branches_plot(
                     &dir.join(format!("frequency_response_{dof}.svg")),
-                    &branch,
+                    &all,
                     i,
                     &format!("Frequency response of {dof}"),
                     &format!("speed ({unit})"),
@@ -252,9 +312,62 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         );
         return Ok(1);
     }
-    Ok(if branch.stop == BranchStop::Reached {
+    let failed: Vec<&Branch> = secondary
+        .iter()
+        .filter(|b| b.stop != BranchStop::Reached)
+        .collect();
+    for b in &failed {
+        eprintln!(
+            "error: {}: a switched branch stopped: {}",
+            scene.file,
+            secondary_line(b, unit, speed)
+        );
+    }
+    Ok(if branch.stop == BranchStop::Reached && failed.is_empty() {
         0
     } else {
         1
     })
+}
+
+/// One line on a secondary branch: where it leaves, its period, its points and end.
+fn secondary_line(b: &Branch, unit: &str, speed: impl Fn(f64) -> f64) -> String {
+    let (what, at, side) = match &b.origin {
+        Some(o) => (
+            match o.bifurcation {
+                hbal::stability::Bifurcation::PeriodDoubling => "period-doubled branch",
+                _ => "branch",
+            },
+            format!("{:.7} {unit}", speed(o.omega)),
+            match o.side {
+                1 => " (side +)",
+                -1 => " (side -)",
+                _ => "",
+            },
+        ),
+        None => ("branch", String::from("?"), ""),
+    };
+    let unstable = b
+        .points
+        .iter()
+        .filter(|p| p.stable() == Some(false))
+        .count();
+    let end = b.points.last().map_or(String::new(), |p| {
+        format!(", ends at {} {unit}", speed(p.omega))
+    });
+    format!(
+        "{what}{side} from the {} at {at}{}: {} points{end}, {} unstable: {}",
+        match b.origin.as_ref().map(|o| o.bifurcation) {
+            Some(hbal::stability::Bifurcation::PeriodDoubling) => "period doubling",
+            _ => "branch point",
+        },
+        if b.subharmonic > 1 {
+            format!(", period {}T", b.subharmonic)
+        } else {
+            String::new()
+        },
+        b.points.len(),
+        unstable,
+        b.stop
+    )
 }

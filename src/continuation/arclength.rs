@@ -109,6 +109,7 @@ impl Continuation {
         }
         let range = Range { back: None, to };
         self.follow(&mut tr, model, &mut branch, x, from, t, range, progress);
+        self.locate_bifurcations(model, basis, &mut branch)?;
         Ok(branch)
     }
 

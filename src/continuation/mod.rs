@@ -60,6 +60,12 @@ pub struct BranchPoint {
     /// Stability changed between the previous point and this one, with this kind of
     /// critical multiplier.
     pub bifurcation: Option<Bifurcation>,
+    /// Where the critical multiplier crosses the unit circle between the previous point and
+    /// this one (a branch point, period doubling or Neimark–Sacker point; folds have
+    /// [`BranchPoint::fold_omega`]), located on the branch by regula falsi on the exact
+    /// orbits' multipliers.
+    #[serde(default)]
+    pub bifurcation_omega: Option<f64>,
 }
 
 impl BranchPoint {

@@ -81,6 +81,7 @@ impl Continuation {
             spurious_turn: false,
             fold_omega: None,
             bifurcation,
+            bifurcation_omega: None,
         });
         failure
     }

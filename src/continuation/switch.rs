@@ -188,9 +188,35 @@ impl Continuation {
                 }
             };
             self.follow(&mut tr, model, &mut branch, x, omega, t_new, range, |_| {});
+            self.locate_bifurcations(model, basis, &mut branch)?;
             out.push(branch);
         }
         Ok(out)
+    }
+
+    /// Sets [`BranchPoint::bifurcation_omega`](super::BranchPoint::bifurcation_omega) of every
+    /// point of `branch` (on `basis`) that closes a stability change other than a fold.
+    pub(super) fn locate_bifurcations(
+        &self,
+        model: &Model,
+        basis: HarmonicBasis,
+        branch: &mut Branch,
+    ) -> Result<()> {
+        if self.stability.is_none() {
+            return Ok(());
+        }
+        for i in 1..branch.points.len() {
+            let kind = match branch.points[i].bifurcation {
+                Some(Bifurcation::Fold) | None => continue,
+                Some(k) => k,
+            };
+            let (a, b) = (&branch.points[i - 1], &branch.points[i]);
+            // A failure leaves the point as it is: the bifurcation is still reported there.
+            if let Ok(Some((_, omega))) = self.locate(model, basis, a, b, kind) {
+                branch.points[i].bifurcation_omega = Some(omega);
+            }
+        }
+        Ok(())
     }
 
     /// The orbit on the parent branch (on its basis) between the points `a` and `b` where the
@@ -343,10 +369,17 @@ fn null_direction(tr: &mut Tracer, x: &[f64], omega: f64, t: &mut [f64]) -> Opti
 
 /// How far the critical multiplier of `kind` is outside the unit circle: `μ - 1` for the real
 /// multiplier nearest +1 (a branch point or fold), `-μ - 1` for the real one nearest −1 (a
-/// period doubling).
+/// period doubling), `|μ| - 1` for the largest complex one (Neimark–Sacker).
 fn critical_value(f: &Floquet, kind: Bifurcation) -> Option<f64> {
     let target = match kind {
         Bifurcation::PeriodDoubling => -1.0,
+        Bifurcation::NeimarkSacker => {
+            return f
+                .multipliers
+                .iter()
+                .find(|m| m.im.abs() > 1e-9 * m.norm().max(1.0))
+                .map(|m| m.norm() - 1.0);
+        }
         _ => 1.0,
     };
     f.multipliers

@@ -11,7 +11,8 @@ use std::path::Path;
 /// empty without stability), then the point's relative residual, its truncation estimate, the
 /// interpolated fold position (empty unless the point closes a fold) and whether a turning
 /// point of the discretised branch ends here that the multipliers do not confirm
-/// (`spurious_turn`). `parameter(p)` maps the point's swept parameter and the fold position to
+/// (`spurious_turn`), and the located position of a bifurcation other than a fold (empty
+/// unless the point closes one). `parameter(p)` maps the point's swept parameter and the fold position to
 /// the parameter's unit (e.g. Ω to rpm).
 pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
     let mut s = String::new();
@@ -24,7 +25,7 @@ pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64)
             let _ = write!(s, ",amp_{d}_{k}");
         }
     }
-    s.push_str(",multipliers_abs,residual,truncation,fold_speed,spurious_turn\n");
+    s.push_str(",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed\n");
     let n = branch.dofs.len();
     for p in &branch.points {
         let stable = match p.stable() {
@@ -51,9 +52,13 @@ pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64)
             (true, Some(w)) => format!("{:e}", parameter(w)),
             _ => String::new(),
         };
+        let bif_at = p
+            .bifurcation_omega
+            .map(|w| format!("{:e}", parameter(w)))
+            .unwrap_or_default();
         let _ = writeln!(
             s,
-            ",{},{:e},{:e},{fold_at},{}",
+            ",{},{:e},{:e},{fold_at},{},{bif_at}",
             mult.join(";"),
             p.residual,
             p.truncation,
@@ -73,54 +78,98 @@ pub fn branch_plot(
     x_label: &str,
     parameter: impl Fn(f64) -> f64,
 ) -> Result<(), Box<dyn std::error::Error>> {
+    branches_plot(path, &[branch], dof, title, x_label, parameter)
+}
+
+/// The frequency-response plot of several branches (the first the main one, the others
+/// switched from it): one colour per branch, stable parts solid, unstable parts dashed, folds
+/// and the points where the switched branches leave as markers.
+pub fn branches_plot(
+    path: &Path,
+    branches: &[&Branch],
+    dof: usize,
+    title: &str,
+    x_label: &str,
+    parameter: impl Fn(f64) -> f64,
+) -> Result<(), Box<dyn std::error::Error>> {
     let mut series: Vec<Series> = Vec::new();
-    let mut current: Vec<(f64, f64)> = Vec::new();
-    let mut current_stable = None;
-    let (mut said_stable, mut said_unstable) = (false, false);
-    let mut flush = |pts: Vec<(f64, f64)>, stable: Option<bool>, series: &mut Vec<Series>| {
-        if pts.len() < 2 {
-            return;
-        }
-        let s = match stable {
-            Some(false) => {
-                let label = if said_unstable { "" } else { "unstable" };
-                said_unstable = true;
-                Series::dashed(label, pts).with_color(1)
-            }
-            _ => {
-                let label = if said_stable { "" } else { "stable" };
-                said_stable = true;
-                Series::line(label, pts).with_color(0)
-            }
+    let mut folds: Vec<(f64, f64)> = Vec::new();
+    let mut switches: Vec<(f64, f64)> = Vec::new();
+    for (index, branch) in branches.iter().enumerate() {
+        let name = match (&branch.origin, branch.subharmonic) {
+            (None, _) => String::new(),
+            (Some(_), nu) if nu > 1 => format!("period {nu}T, "),
+            (Some(o), _) => format!("branch {}, ", if o.side < 0 { "-" } else { "+" }),
         };
-        series.push(s);
-    };
-    for p in &branch.points {
-        let xy = (parameter(p.parameter), p.max_abs[dof]);
-        let st = p.stable();
-        if current_stable.is_some() && st != current_stable {
-            // Close the segment at this point so the curve stays connected.
+        // Colours: the main branch 0 (stable) and 1 (unstable); switched branches 3, 4, ...
+        let colors = if index == 0 {
+            (0, 1)
+        } else {
+            (2 + index, 2 + index)
+        };
+        let (mut said_stable, mut said_unstable) = (false, false);
+        let mut flush = |pts: Vec<(f64, f64)>, stable: Option<bool>, series: &mut Vec<Series>| {
+            if pts.len() < 2 {
+                return;
+            }
+            let s = match stable {
+                Some(false) => {
+                    let label = if said_unstable {
+                        String::new()
+                    } else {
+                        format!("{name}unstable")
+                    };
+                    said_unstable = true;
+                    Series::dashed(label, pts).with_color(colors.1)
+                }
+                _ => {
+                    let label = if said_stable {
+                        String::new()
+                    } else {
+                        format!("{name}stable")
+                    };
+                    said_stable = true;
+                    Series::line(label, pts).with_color(colors.0)
+                }
+            };
+            series.push(s);
+        };
+        let mut current: Vec<(f64, f64)> = Vec::new();
+        let mut current_stable = None;
+        for p in &branch.points {
+            let xy = (parameter(p.parameter), p.max_abs[dof]);
+            let st = p.stable();
+            if current_stable.is_some() && st != current_stable {
+                // Close the segment at this point so the curve stays connected.
+                current.push(xy);
+                flush(std::mem::take(&mut current), current_stable, &mut series);
+            }
+            current_stable = st;
             current.push(xy);
-            flush(std::mem::take(&mut current), current_stable, &mut series);
         }
-        current_stable = st;
-        current.push(xy);
+        flush(current, current_stable, &mut series);
+        folds.extend(
+            branch
+                .points
+                .iter()
+                .filter(|p| p.fold)
+                .map(|p| (parameter(p.parameter), p.max_abs[dof])),
+        );
+        if let (Some(_), Some(first)) = (&branch.origin, branch.points.first()) {
+            switches.push((parameter(first.parameter), first.max_abs[dof]));
+        }
     }
-    flush(current, current_stable, &mut series);
-    let folds: Vec<(f64, f64)> = branch
-        .points
-        .iter()
-        .filter(|p| p.fold)
-        .map(|p| (parameter(p.parameter), p.max_abs[dof]))
-        .collect();
     if !folds.is_empty() {
         series.push(Series::markers("fold", folds).with_color(2));
+    }
+    if !switches.is_empty() {
+        series.push(Series::markers("switched branch starts", switches).with_color(2));
     }
     line_plot(
         path,
         title,
         &Axis::linear(x_label),
-        &Axis::linear(format!("max |{}|", branch.dofs[dof])),
+        &Axis::linear(format!("max |{}|", branches[0].dofs[dof])),
         &series,
     )
 }

@@ -1,0 +1,113 @@
+//! `hbal sweep --all-branches`: the period-2 orbit of the gear pair's parametric resonance out
+//! of one sweep, with the period doubling located; and the bad uses of the flag.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn hbal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args(args)
+        .output()
+        .expect("run hbal")
+}
+
+fn scene() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/gear_backlash_period_doubling.toml")
+}
+
+/// W_pd of the independent reference (tests/data/period2/gear_backlash_pd.json).
+const W_PD: f64 = 2.1654112939172774;
+
+#[test]
+fn all_branches_finds_the_period_two_orbit() {
+    let dir = std::env::temp_dir().join(format!("hbal-cli-branches-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let s = scene();
+    let out = hbal(&[
+        "sweep",
+        s.to_str().unwrap(),
+        "--from",
+        "2.3",
+        "--to",
+        "2.0",
+        "--all-branches",
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The main branch says where its stability changes, located to the reference's 1e-6.
+    let located: Vec<f64> = doc["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|p| p["bifurcation_speed"].as_f64())
+        .collect();
+    assert_eq!(located.len(), 1, "{located:?}");
+    assert!((located[0] - W_PD).abs() < 1e-6, "{}", located[0]);
+    let branches = doc["branches"].as_array().unwrap();
+    assert_eq!(branches.len(), 1);
+    let b = &branches[0];
+    assert_eq!(b["bifurcation"], "PeriodDoubling");
+    assert_eq!(b["period_multiple"], 2);
+    assert_eq!(b["reached"], true, "{}", b["stop"]);
+    assert!((b["from_speed"].as_f64().unwrap() - W_PD).abs() < 1e-6);
+    let points = b["points"].as_array().unwrap();
+    let last = points.last().unwrap();
+    assert_eq!(last["speed"], 2.0);
+    assert_eq!(last["stable"], true);
+    // Harmonic 1 of the period-2 orbit is shaft order 1/2, and it is there.
+    let h1 = &last["harmonics"][0][1];
+    assert_eq!(h1["order"], 0.5);
+    assert!(
+        h1["cos"]
+            .as_f64()
+            .unwrap()
+            .hypot(h1["sin"].as_f64().unwrap())
+            > 0.1
+    );
+    let csv = std::fs::read_to_string(dir.join("branch_1.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with("bifurcation_speed"));
+    assert_eq!(csv.lines().count(), points.len() + 1);
+    let svg = std::fs::read_to_string(dir.join("frequency_response_x.svg")).unwrap();
+    assert!(
+        svg.contains("period 2T"),
+        "the plot names the period-2 branch"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn all_branches_needs_stability_and_a_speed_sweep() {
+    let s = scene();
+    let s = s.to_str().unwrap();
+    let out = hbal(&[
+        "sweep",
+        s,
+        "--to",
+        "2.0",
+        "--all-branches",
+        "--no-stability",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--all-branches needs the stability"));
+    let out = hbal(&[
+        "sweep",
+        s,
+        "--to",
+        "0.1",
+        "--from",
+        "0.01",
+        "--all-branches",
+        "--parameter",
+        "loads[1].cos",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--parameter"));
+}
