@@ -73,6 +73,17 @@ pub enum Error {
         /// H.
         harmonics: usize,
     },
+    /// An element's time variation (a mesh order) lies above the number of harmonics: its
+    /// response would be missing, or aliased onto lower harmonics.
+    #[error("element `{element}` varies at order {order} (its mesh cycles per period) but only {harmonics} harmonics are kept: raise H to at least {order}, better a few times that")]
+    ElementOrderTooHigh {
+        /// The element.
+        element: String,
+        /// Its order.
+        order: usize,
+        /// H.
+        harmonics: usize,
+    },
     /// The dynamic stiffness `-(k Ω)² M + i k Ω D0 + K0` is singular at harmonic `k`:
     /// an undamped resonance (or, at k = 0, a rigid-body mode under a static load).
     #[error("dynamic stiffness is singular at harmonic {harmonic} (frequency {omega} rad/s, relative pivot {relative_pivot:.3e}): {hint}")]

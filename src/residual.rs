@@ -37,10 +37,13 @@ pub struct HarmonicBalance<'m> {
     thetas: Vec<f64>,
 }
 
-/// A time-varying or nonlinear element and the samples that sit on its time jumps.
+/// A time-varying or nonlinear element, the law the AFT evaluates for it (its band-limited
+/// copy where it has one, see [`ForceLaw::band_limited`](crate::force::ForceLaw::band_limited))
+/// and the samples that sit on its time jumps.
 #[derive(Debug, Clone)]
 struct ActiveElement {
     index: usize,
+    band_limited: Option<std::sync::Arc<dyn crate::force::ForceLaw>>,
     jump_samples: Vec<usize>,
 }
 
@@ -84,7 +87,8 @@ impl Workspace {
 impl<'m> HarmonicBalance<'m> {
     /// Discretises `model` on `basis`: plans the FFTs, factors `Z_k` for `k = 0..=H`.
     ///
-    /// Errors: a load order above H, or a singular `Z_k` (undamped resonance at a harmonic, or a
+    /// Errors: a load order or an element's time order (a mesh order) above H (unless H = 0, a
+    /// static analysis), or a singular `Z_k` (undamped resonance at a harmonic, or a
     /// rigid-body mode at k = 0).
     pub fn new(model: &'m Model, basis: HarmonicBasis) -> Result<Self> {
         let (n, h) = (model.n_dofs(), basis.harmonics());
@@ -107,6 +111,18 @@ impl<'m> HarmonicBalance<'m> {
             }
             f_ext[l.order * nu * n + l.dof] += crate::harmonic::from_cos_sin(l.cos, l.sin);
         }
+        // H = 0 is a static analysis by choice; otherwise every time variation must fit.
+        for e in model.elements().iter().filter(|_| h > 0) {
+            if let Some(order) = e.law().time_order() {
+                if order * nu > h {
+                    return Err(Error::ElementOrderTooHigh {
+                        element: e.name().to_string(),
+                        order,
+                        harmonics: h / nu,
+                    });
+                }
+            }
+        }
         let mut f_split = f_ext.clone();
         for e in model.elements() {
             e.scatter_add(
@@ -119,14 +135,24 @@ impl<'m> HarmonicBalance<'m> {
         let samples = basis.samples();
         // The laws see the shaft angle Ωt = ν θ_j.
         let thetas: Vec<f64> = (0..samples).map(|j| basis.shaft_angle(j)).collect();
+        // Time-varying coefficients keep the orders of θ up to 2H/ν (all of them alias-free
+        // with N >= 4H + 1; fewer when N is forced lower).
+        let h = basis.harmonics();
+        let band = if samples > 4 * h {
+            2 * h
+        } else {
+            samples.saturating_sub(2 * h + 1).max(h / 2)
+        } / nu;
         let active = model
             .elements()
             .iter()
             .enumerate()
             .filter(|(_, e)| !e.law().is_linear_time_invariant())
             .map(|(index, e)| {
-                let mut jump_samples: Vec<usize> = e
-                    .law()
+                let band_limited: Option<std::sync::Arc<dyn crate::force::ForceLaw>> =
+                    e.law().band_limited(samples, band).map(Into::into);
+                let law = band_limited.as_deref().unwrap_or(e.law());
+                let mut jump_samples: Vec<usize> = law
                     .time_breakpoints()
                     .iter()
                     .flat_map(|&b| (0..nu).map(move |r| (b + TAU * r as f64) / nu as f64))
@@ -140,6 +166,7 @@ impl<'m> HarmonicBalance<'m> {
                 jump_samples.dedup();
                 ActiveElement {
                     index,
+                    band_limited,
                     jump_samples,
                 }
             })
@@ -256,7 +283,7 @@ impl<'m> HarmonicBalance<'m> {
         for act in &self.active {
             let e = &self.model.elements()[act.index];
             self.element_samples(e, q, ws);
-            let law = e.law();
+            let law = self.law(act);
             let lin = e.linear_part();
             law.force_batch(&self.thetas, &ws.u, &ws.du, &mut ws.f);
             for ((f, &u), &du) in ws.f.iter_mut().zip(&ws.u).zip(&ws.du) {
@@ -384,6 +411,13 @@ impl<'m> HarmonicBalance<'m> {
         Ok(())
     }
 
+    /// The law the AFT evaluates for `act`.
+    fn law<'a>(&'a self, act: &'a ActiveElement) -> &'a dyn crate::force::ForceLaw {
+        act.band_limited
+            .as_deref()
+            .unwrap_or(self.model.elements()[act.index].law())
+    }
+
     /// `u(θ_j)`, `u̇(θ_j)` of element `e` at the samples into `b.u`, `b.du` (its local
     /// harmonics `U_k = w·Q_k` in `b.uk`).
     fn element_samples(&self, e: &crate::Element, q: &[Complex64], b: &mut AftBuffers) {
@@ -404,7 +438,7 @@ impl<'m> HarmonicBalance<'m> {
     /// `∂f/∂u`, `∂f/∂u̇` at the samples into `b.gu`, `b.gdu`; a sample on a time jump takes the
     /// mean of both one-sided limits, as the force does.
     fn derivative_samples(&self, act: &ActiveElement, b: &mut AftBuffers) {
-        let law = self.model.elements()[act.index].law();
+        let law = self.law(act);
         law.derivatives_batch(&self.thetas, &b.u, &b.du, &mut b.gu, &mut b.gdu);
         let delta = 1e-7 * TAU / self.basis.samples() as f64;
         for &j in &act.jump_samples {

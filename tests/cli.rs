@@ -586,12 +586,16 @@ fn solve_start_file_round_trip() {
         p,
         "--json",
         "--harmonics",
-        "8",
+        "32",
         "--start",
         file.to_str().unwrap(),
     ]);
     assert_eq!(out.status.code(), Some(0));
-    assert_eq!(json_of(&out)["harmonics"], 8);
+    assert_eq!(json_of(&out)["harmonics"], 32);
+    // Fewer harmonics than the mesh order (20 teeth) is refused, naming the element.
+    let out = hbal(&["solve", p, "--harmonics", "8"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("element `mesh` varies at order 20"));
     // The start picks the orbit: the backlash pair at W = 0.8 started on the stable orbit of
     // W = 0.7 stays on the stable lower orbit, not the unstable middle one.
     let gb = dir.join("gb07.json");

@@ -170,6 +170,20 @@ impl ForceLaw for Backlash {
     fn time_breakpoints(&self) -> Vec<f64> {
         jump_angles(&self.stiffness.jumps(), self.teeth, self.phase)
     }
+    fn time_order(&self) -> Option<usize> {
+        let constant = matches!(self.stiffness, MeshProfile::Constant { .. })
+            || matches!(self.stiffness, MeshProfile::Cosine { amplitude, .. } if amplitude == 0.0);
+        (!constant).then_some(self.teeth as usize)
+    }
+    fn band_limited(&self, samples: usize, max_order: usize) -> Option<Box<dyn ForceLaw>> {
+        let stiffness = self
+            .stiffness
+            .for_samples(self.teeth, self.phase, samples, max_order)?;
+        Some(Box::new(Self {
+            stiffness,
+            ..self.clone()
+        }))
+    }
     fn validate(&self, context: &str) -> Result<()> {
         check_non_negative(context, "half_backlash", self.half_backlash)?;
         if self.teeth == 0 {

@@ -119,6 +119,20 @@ impl ForceLaw for MeshStiffness {
     fn time_breakpoints(&self) -> Vec<f64> {
         jump_angles(&self.profile.jumps(), self.teeth, self.phase)
     }
+    fn time_order(&self) -> Option<usize> {
+        let constant = matches!(self.profile, MeshProfile::Constant { .. })
+            || matches!(self.profile, MeshProfile::Cosine { amplitude, .. } if amplitude == 0.0);
+        (!constant).then_some(self.teeth as usize)
+    }
+    fn band_limited(&self, samples: usize, max_order: usize) -> Option<Box<dyn ForceLaw>> {
+        let profile = self
+            .profile
+            .for_samples(self.teeth, self.phase, samples, max_order)?;
+        Some(Box::new(Self {
+            profile,
+            ..self.clone()
+        }))
+    }
     fn validate(&self, context: &str) -> Result<()> {
         if self.teeth == 0 {
             return Err(Error::invalid(context, "teeth", 0.0, "an integer >= 1"));

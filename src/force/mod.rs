@@ -145,6 +145,27 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
         Vec::new()
     }
 
+    /// The order (per revolution of θ) at which the law varies in time, if it does: the mesh
+    /// cycles per period of a mesh stiffness. A harmonic basis with fewer harmonics cannot
+    /// represent the variation and is refused ([`crate::HarmonicBalance::new`]). Default: none.
+    fn time_order(&self) -> Option<usize> {
+        None
+    }
+
+    /// A copy of this law for a harmonic basis with `samples` time samples per revolution of
+    /// the shaft angle θ, whose time-varying coefficients keep only their Fourier orders in θ
+    /// up to `max_order` and are tabulated at the sample angles `2π i / samples`; `None` (the
+    /// default) where the law is sampled exactly as it is.
+    ///
+    /// The AFT evaluates this copy. A stiffness that jumps between samples otherwise costs
+    /// O(1/N) in every harmonic; band-limited to `2H` orders (with `N >= 4H + 1`), the AFT of
+    /// `k(θ) u` is the exact Galerkin projection of the product onto the kept harmonics. The
+    /// time-domain reference and the Floquet analysis keep the law itself.
+    fn band_limited(&self, samples: usize, max_order: usize) -> Option<Box<dyn ForceLaw>> {
+        let _ = (samples, max_order);
+        None
+    }
+
     /// Values of `u` where the law is not smooth (a contact edge): its derivatives, and
     /// possibly the force itself (contact damping), jump when `u` crosses one of them.
     ///

@@ -1,7 +1,9 @@
 //! Periodic mesh-stiffness and mesh-damping profiles over the mesh angle `φ = z θ + φ0`.
 
 use crate::error::{check_finite, check_non_negative, Error, Result};
+use num_complex::Complex64;
 use std::f64::consts::TAU;
+use std::sync::Arc;
 
 /// Stiffness `k(φ)` over one mesh cycle, `φ = z θ + φ0` (`z` mesh cycles per fundamental period,
 /// `φ0` the phase in rad). Scene files name the shape in the field `shape`.
@@ -42,6 +44,77 @@ pub enum MeshProfile {
         #[serde(default)]
         sin: Vec<f64>,
     },
+    /// A band-limited profile tabulated at the AFT's sample angles (built by
+    /// [`ForceLaw::band_limited`](super::ForceLaw::band_limited) for one harmonic basis; not
+    /// in scene files).
+    #[serde(skip)]
+    Sampled(Arc<SampledProfile>),
+}
+
+/// A [`MeshProfile::Fourier`] tabulated at the shaft angles `θ_i = 2π i / N` of a mesh
+/// `φ = z θ + φ0`: a lookup at those angles, the Fourier sum elsewhere.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampledProfile {
+    fourier: MeshProfile,
+    teeth: f64,
+    phase: f64,
+    values: Vec<f64>,
+}
+
+impl SampledProfile {
+    /// `profile` truncated to its orders `1..=orders` ([`MeshProfile::band_limited`]) and
+    /// tabulated at the `samples` shaft angles of a mesh with `teeth` cycles per revolution and
+    /// phase `phase`, by one inverse real FFT. Requires `orders · teeth < samples / 2`.
+    pub fn new(
+        profile: &MeshProfile,
+        orders: usize,
+        teeth: u32,
+        phase: f64,
+        samples: usize,
+    ) -> Self {
+        let fourier = profile.band_limited(orders);
+        let z = teeth as usize;
+        let top = (samples - 1) / 2;
+        let mut x = vec![Complex64::default(); top + 1];
+        if let MeshProfile::Fourier { mean, cos, sin } = &fourier {
+            x[0] = Complex64::new(*mean, 0.0);
+            for j in 1..=cos.len().max(sin.len()) {
+                if j * z > top {
+                    break;
+                }
+                let c = cos.get(j - 1).copied().unwrap_or(0.0);
+                let s = sin.get(j - 1).copied().unwrap_or(0.0);
+                x[j * z] += Complex64::new(c, -s) * Complex64::from_polar(1.0, j as f64 * phase);
+            }
+        } else {
+            x[0] = Complex64::new(fourier.mean(), 0.0);
+        }
+        let mut values = vec![0.0; samples];
+        if let Ok(basis) = crate::HarmonicBasis::new(1.0, top).and_then(|b| b.with_samples(samples))
+        {
+            let plan = crate::harmonic::AftPlan::new(basis);
+            let mut scratch = plan.make_scratch();
+            plan.synthesize_into(&x, |_| Complex64::new(1.0, 0.0), &mut values, &mut scratch);
+        }
+        Self {
+            fourier,
+            teeth: teeth as f64,
+            phase,
+            values,
+        }
+    }
+
+    #[inline]
+    fn value(&self, phi: f64) -> f64 {
+        let n = self.values.len();
+        let x = (phi - self.phase) / self.teeth * (n as f64 / TAU);
+        let i = x.round();
+        if (x - i).abs() <= 1e-7 {
+            self.values[(i as i64).rem_euclid(n as i64) as usize]
+        } else {
+            self.fourier.value(phi)
+        }
+    }
 }
 
 impl MeshProfile {
@@ -72,6 +145,7 @@ impl MeshProfile {
                 }
                 k
             }
+            MeshProfile::Sampled(table) => table.value(phi),
         }
     }
 
@@ -111,6 +185,60 @@ impl MeshProfile {
                 contact_ratio,
             } => (contact_ratio - 1.0) * two_tooth + (2.0 - contact_ratio) * one_tooth,
             MeshProfile::Cosine { mean, .. } | MeshProfile::Fourier { mean, .. } => *mean,
+            MeshProfile::Sampled(table) => table.fourier.mean(),
+        }
+    }
+
+    /// The profile truncated to its Fourier orders `1..=orders` (exact coefficients), as a
+    /// [`MeshProfile::Fourier`]; a constant or cosine profile is returned as it is (already
+    /// band-limited), `orders = 0` gives the mean.
+    ///
+    /// Evaluated at the samples, the truncated profile makes the AFT of `k(φ) u` the exact
+    /// Galerkin projection onto the kept harmonics when the product's orders stay below the
+    /// aliasing limit (see [`crate::HarmonicBalance`]), whereas sampling a jump costs O(1/N).
+    ///
+    /// The rectangular profile is `k1 + (k2 - k1) 1[0, a)(φ)` per cycle with `a = 2π(ε - 1)`,
+    /// so `cos[j-1] = (k2 - k1) sin(j a) / (j π)` and `sin[j-1] = (k2 - k1) (1 - cos(j a)) / (j π)`.
+    ///
+    /// ```
+    /// use hbal::force::MeshProfile;
+    /// let rect = MeshProfile::Rectangular { one_tooth: 1.0, two_tooth: 2.0, contact_ratio: 1.5 };
+    /// let smooth = rect.band_limited(2000);
+    /// assert!((smooth.mean() - 1.5).abs() < 1e-15);
+    /// assert!((smooth.value(0.75 * std::f64::consts::TAU) - 1.0).abs() < 1e-3); // one tooth
+    /// assert!((smooth.value(1.0) - 2.0).abs() < 1e-3);                         // two teeth
+    /// ```
+    pub fn band_limited(&self, orders: usize) -> MeshProfile {
+        match self {
+            MeshProfile::Rectangular {
+                one_tooth,
+                two_tooth,
+                contact_ratio,
+            } => {
+                let a = TAU * (contact_ratio - 1.0);
+                let dk = two_tooth - one_tooth;
+                let c = (1..=orders)
+                    .map(|j| dk * (j as f64 * a).sin() / (j as f64 * std::f64::consts::PI))
+                    .collect();
+                let s = (1..=orders)
+                    .map(|j| dk * (1.0 - (j as f64 * a).cos()) / (j as f64 * std::f64::consts::PI))
+                    .collect();
+                MeshProfile::Fourier {
+                    mean: self.mean(),
+                    cos: c,
+                    sin: s,
+                }
+            }
+            MeshProfile::Fourier { mean, cos, sin } => MeshProfile::Fourier {
+                mean: *mean,
+                cos: cos.iter().take(orders).copied().collect(),
+                sin: sin.iter().take(orders).copied().collect(),
+            },
+            MeshProfile::Cosine { mean, .. } if orders == 0 => {
+                MeshProfile::Constant { stiffness: *mean }
+            }
+            MeshProfile::Sampled(table) => table.fourier.band_limited(orders),
+            other => other.clone(),
         }
     }
 
@@ -165,7 +293,32 @@ impl MeshProfile {
                 }
                 Ok(())
             }
+            MeshProfile::Sampled(_) => Ok(()),
         }
+    }
+
+    /// The profile a harmonic basis with `samples` shaft angles per revolution should evaluate
+    /// instead of this one, keeping the orders of `θ` up to `max_order` (see
+    /// [`ForceLaw::band_limited`](super::ForceLaw::band_limited)): `None` where sampling the
+    /// profile itself is exact (constant, cosine, a Fourier series within the limit).
+    pub fn for_samples(
+        &self,
+        teeth: u32,
+        phase: f64,
+        samples: usize,
+        max_order: usize,
+    ) -> Option<MeshProfile> {
+        let orders = max_order / teeth.max(1) as usize;
+        let needed = match self {
+            MeshProfile::Rectangular { .. } => !self.jumps().is_empty(),
+            MeshProfile::Fourier { cos, sin, .. } => cos.len().max(sin.len()) > orders,
+            _ => false,
+        };
+        needed.then(|| {
+            MeshProfile::Sampled(Arc::new(SampledProfile::new(
+                self, orders, teeth, phase, samples,
+            )))
+        })
     }
 }
 
