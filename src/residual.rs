@@ -45,6 +45,8 @@ struct ActiveElement {
     index: usize,
     band_limited: Option<std::sync::Arc<dyn crate::force::ForceLaw>>,
     jump_samples: Vec<usize>,
+    /// The law's kinks in `u`, whose crossings the quadrature corrects.
+    kinks: Vec<f64>,
 }
 
 /// Buffers of one AFT pass and its work counters.
@@ -60,6 +62,7 @@ pub struct AftBuffers {
     spec_u: Vec<Complex64>,
     spec_du: Vec<Complex64>,
     jac_scratch: crate::jacobian::JacobianScratch,
+    crossings: Vec<crate::harmonic::kinks::Crossing>,
     /// Real FFTs done so far.
     pub ffts: usize,
     /// Force-law calls so far.
@@ -166,6 +169,7 @@ impl<'m> HarmonicBalance<'m> {
                 jump_samples.dedup();
                 ActiveElement {
                     index,
+                    kinks: law.kinks(),
                     band_limited,
                     jump_samples,
                 }
@@ -246,6 +250,7 @@ impl<'m> HarmonicBalance<'m> {
                 spec_u: vec![Complex64::default(); s / 2 + 1],
                 spec_du: vec![Complex64::default(); s / 2 + 1],
                 jac_scratch: crate::jacobian::JacobianScratch::new(h),
+                crossings: Vec::with_capacity(16),
                 ffts: 0,
                 force_evaluations: 0,
             },
@@ -302,8 +307,28 @@ impl<'m> HarmonicBalance<'m> {
                     what: format!("force of element `{}`", e.name()),
                 });
             }
+            // Contact edges crossed between samples: the trapezoid error, from the local
+            // harmonics still in `uk` (see [`crate::harmonic::kinks`]).
+            ws.crossings.clear();
+            if !act.kinks.is_empty() {
+                crate::harmonic::kinks::find_crossings(
+                    law,
+                    &act.kinks,
+                    &ws.u,
+                    &ws.uk,
+                    omega,
+                    self.basis.subharmonic(),
+                    &mut ws.crossings,
+                );
+                ws.force_evaluations += 12 * ws.crossings.len();
+            }
             self.aft.analyze_into(&mut ws.f, &mut ws.uk, &mut ws.aft);
             ws.ffts += 3;
+            crate::harmonic::kinks::correct_harmonics(
+                &mut ws.uk,
+                self.basis.samples(),
+                &ws.crossings,
+            );
             for k in 0..=h {
                 e.scatter_add(ws.uk[k], &mut out[k * n..(k + 1) * n]);
             }
@@ -323,6 +348,19 @@ impl<'m> HarmonicBalance<'m> {
                 self.aft
                     .spectrum_into(&mut ws.gdu, &mut ws.spec_du, &mut ws.aft);
                 ws.ffts += 2;
+                let samples = self.basis.samples();
+                crate::harmonic::kinks::correct_spectrum(
+                    &mut ws.spec_u,
+                    samples,
+                    &ws.crossings,
+                    false,
+                );
+                crate::harmonic::kinks::correct_spectrum(
+                    &mut ws.spec_du,
+                    samples,
+                    &ws.crossings,
+                    true,
+                );
                 crate::jacobian::add_element_jacobian(
                     &ws.spec_u,
                     &ws.spec_du,

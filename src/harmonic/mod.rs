@@ -11,6 +11,7 @@
 mod aft;
 mod basis;
 mod dynamic_stiffness;
+pub mod kinks;
 mod packing;
 
 pub use aft::{AftPlan, AftScratch};

@@ -1,0 +1,319 @@
+//! Kink-aware quadrature: the AFT's trapezoid rule corrected at the crossings of a contact edge.
+//!
+//! The AFT computes `X_k = (1/π) T_k` (`1/2π` for k = 0) from the trapezoid sum
+//! `T_k = h Σ_j f(θ_j) e^{-ikθ_j}`, `h = 2π/N`, which is spectrally accurate for a smooth
+//! periodic `f`. A contact law makes `f(θ) = F(θ, u(θ), u̇(θ))` only piecewise smooth: where
+//! `u` crosses a kink `κ` of the law (a backlash edge) at `θ* = θ_j + α h`, the force or its
+//! derivatives jump, and the trapezoid sum is off by (Euler–Maclaurin with a jump, from the
+//! multiplication theorem of the Bernoulli polynomials `B_m`)
+//!
+//! `T - I = [g] h B₁(α) - [g'] h²/2 B₂(α) + [g''] h³/6 B₃(α) - ... = Σ_m (-1)^m [g^(m)] h^{m+1}/(m+1)! B_{m+1}(α)`
+//!
+//! for an integrand `g` whose value and first two derivatives jump by `[g]`, `[g']`, `[g'']`
+//! (right minus left). With `g = f e^{-ikθ}`: `[g] = [f] e_k`, `[g'] = ([f'] - ik[f]) e_k`,
+//! `[g''] = ([f''] - 2ik[f'] - k²[f]) e_k`, `e_k = e^{-ikθ*}`. Subtracting it turns the
+//! O(1/N²) error of a kink (O(1/N) of a force jump) into O(1/N⁴), at the cost of a few law
+//! evaluations per crossing.
+//!
+//! The jumps of `f` along the orbit come from the law's one-sided values and derivatives at
+//! `u = κ ± δ`: with `D = F₊ - F₋` (the difference of the two smooth pieces), `[f] = s D`,
+//! `[f'] = s dD/dθ`, `[f''] = s d²D/dθ²` along `(θ, u(θ), u̇(θ))`, `s` the sign of `u'(θ*)`.
+//! Second derivatives of `D` in `u`, `u̇` are taken as zero (exact for laws piecewise linear
+//! in `u`, `u̇` such as the backlash); its θ-derivatives are finite differences.
+
+use crate::force::ForceLaw;
+use num_complex::Complex64;
+use std::f64::consts::{PI, TAU};
+
+/// The jumps of the force at one crossing: `θ*` (on the fundamental) and `[f]`, `[f']`,
+/// `[f'']` (derivatives in θ), and of its partial derivatives `∂f/∂u`, `∂f/∂u̇` with their
+/// first θ-derivative (for the Jacobian, [`correct_spectrum`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Crossing {
+    /// θ* in [0, 2π).
+    pub theta: f64,
+    /// `[f]`, `[f']`, `[f'']`.
+    pub jumps: [f64; 3],
+    /// `[∂f/∂u]`, `[(∂f/∂u)']`.
+    pub du_jumps: [f64; 2],
+    /// `[∂f/∂u̇]`, `[(∂f/∂u̇)']`.
+    pub ddu_jumps: [f64; 2],
+}
+
+/// Terms of the Euler–Maclaurin series kept: `m = 0..ORDERS` (the series in `(kh)^m B_{m+1}`
+/// converges for every `k < N`; 11 terms reach 1e-8 of the kink's error at `k = N/4`).
+const ORDERS: usize = 11;
+
+/// Bernoulli numbers `B_0 ..= B_11`.
+const BERNOULLI: [f64; ORDERS + 1] = [
+    1.0,
+    -0.5,
+    1.0 / 6.0,
+    0.0,
+    -1.0 / 30.0,
+    0.0,
+    1.0 / 42.0,
+    0.0,
+    -1.0 / 30.0,
+    0.0,
+    5.0 / 66.0,
+    0.0,
+];
+
+/// Binomial coefficients `C(n, k)` for `n <= ORDERS`.
+fn binomial(n: usize, k: usize) -> f64 {
+    (0..k).fold(1.0, |c, i| c * (n - i) as f64 / (i + 1) as f64)
+}
+
+/// The Bernoulli polynomials `B_1(a) ..= B_ORDERS(a)` (index m holds `B_{m+1}`).
+fn bernoulli_polynomials(a: f64) -> [f64; ORDERS] {
+    let mut out = [0.0; ORDERS];
+    for (m, o) in out.iter_mut().enumerate() {
+        let n = m + 1;
+        *o = (0..=n)
+            .map(|k| binomial(n, k) * BERNOULLI[k] * a.powi((n - k) as i32))
+            .sum();
+    }
+    out
+}
+
+/// Subtracts the trapezoid error of every crossing from the AFT harmonics `x[0..=H]` of `N`
+/// samples: `Σ_m (-1)^m [g^(m)] h^{m+1}/(m+1)! B_{m+1}(α)` with
+/// `[g^(m)] = Σ_{i<=2} C(m, i) [f^(i)] (-ik)^{m-i} e_k` (module documentation; jumps of `f`
+/// beyond the second derivative are taken as zero).
+pub fn correct_harmonics(x: &mut [Complex64], samples: usize, crossings: &[Crossing]) {
+    for c in crossings {
+        correct(x, samples, c.theta, &c.jumps, |k| {
+            if k == 0 {
+                0.5 / PI
+            } else {
+                1.0 / PI
+            }
+        });
+    }
+}
+
+/// Subtracts the trapezoid error of the crossings from the normalised DFT bins
+/// `x̂_m = (1/N) Σ_j g_j e^{-imθ_j}`, `m = 0..`, of the samples of `∂f/∂u` (`of_velocity`
+/// false) or `∂f/∂u̇` (true): the spectra the Jacobian is assembled from
+/// ([`crate::jacobian`]), so that it is the derivative of the corrected residual to the same
+/// order (a sampled step costs O(1/N) in the Jacobian).
+pub fn correct_spectrum(
+    x: &mut [Complex64],
+    samples: usize,
+    crossings: &[Crossing],
+    of_velocity: bool,
+) {
+    for c in crossings {
+        let j = if of_velocity { c.ddu_jumps } else { c.du_jumps };
+        correct(x, samples, c.theta, &j, |_| 0.5 / PI);
+    }
+}
+
+/// `x[k] -= scale(k) Σ_m (-1)^m [g^(m)] h^{m+1}/(m+1)! B_{m+1}(α)` for `g = f e^{-ikθ}` with
+/// the jumps `[f^(i)]` of `jumps` at `theta`.
+fn correct(
+    x: &mut [Complex64],
+    samples: usize,
+    theta: f64,
+    jumps: &[f64],
+    scale: impl Fn(usize) -> f64,
+) {
+    let h = TAU / samples as f64;
+    // (-1)^m h^{m+1} / (m+1)!
+    let mut weight = [0.0; ORDERS];
+    let mut w = h;
+    for (m, wm) in weight.iter_mut().enumerate() {
+        *wm = if m % 2 == 0 { w } else { -w };
+        w *= h / (m + 2) as f64;
+    }
+    let b = bernoulli_polynomials((theta / h).rem_euclid(1.0));
+    // The error is a polynomial in z = -ik: Σ_p coef[p] z^p, coef[p] = Σ_i [f^(i)]
+    // C(p+i, i) weight[p+i] B_{p+i+1}(α).
+    let mut coef = [0.0; ORDERS];
+    for (p, cp) in coef.iter_mut().enumerate() {
+        for (i, f) in jumps.iter().enumerate() {
+            let m = p + i;
+            if m < ORDERS {
+                *cp += f * binomial(m, i) * weight[m] * b[m];
+            }
+        }
+    }
+    let step = Complex64::from_polar(1.0, -theta);
+    let mut e = Complex64::new(1.0, 0.0);
+    for (k, xk) in x.iter_mut().enumerate() {
+        let z = Complex64::new(0.0, -(k as f64));
+        let err = coef
+            .iter()
+            .rev()
+            .fold(Complex64::default(), |acc, cp| acc * z + cp);
+        *xk -= err * e * scale(k);
+        e *= step;
+    }
+}
+
+/// `(u, u', u'', u''')` at θ of `u(θ) = Re Σ_k U_k e^{ikθ}`.
+fn derivatives(uk: &[Complex64], theta: f64) -> [f64; 4] {
+    let step = Complex64::from_polar(1.0, theta);
+    let mut e = Complex64::new(1.0, 0.0);
+    let mut out = [0.0; 4];
+    for (k, u) in uk.iter().enumerate() {
+        let z = u * e;
+        let kf = k as f64;
+        out[0] += z.re;
+        out[1] -= kf * z.im;
+        out[2] -= kf * kf * z.re;
+        out[3] += kf * kf * kf * z.im;
+        e *= step;
+    }
+    out
+}
+
+/// The crossings of the kinks `kinks` by the element coordinate with samples `u` (at
+/// `θ_j = 2π j / N`) and harmonics `uk`, with the jumps of the force of `law` there, appended
+/// to `out`. `fundamental` is the Ω/ν that turns θ-derivatives into time derivatives, `nu` the
+/// ν that turns θ into the law's shaft angle.
+pub fn find_crossings(
+    law: &dyn ForceLaw,
+    kinks: &[f64],
+    u: &[f64],
+    uk: &[Complex64],
+    fundamental: f64,
+    nu: usize,
+    out: &mut Vec<Crossing>,
+) {
+    let n = u.len();
+    let h = TAU / n as f64;
+    for &kappa in kinks {
+        for j in 0..n {
+            let (a, b) = (u[j] - kappa, u[(j + 1) % n] - kappa);
+            if a * b >= 0.0 {
+                continue;
+            }
+            // Safeguarded Newton on the trigonometric polynomial in [θ_j, θ_j + h].
+            let (mut lo, mut hi) = (j as f64 * h, (j + 1) as f64 * h);
+            let mut t = lo + h * a / (a - b);
+            for _ in 0..60 {
+                let d = derivatives(uk, t);
+                let r = d[0] - kappa;
+                if r.abs() <= 1e-14 * (1.0 + kappa.abs()) {
+                    break;
+                }
+                if (r < 0.0) == (a < 0.0) {
+                    lo = t;
+                } else {
+                    hi = t;
+                }
+                let next = t - r / d[1];
+                let next = if next >= lo && next <= hi && next.is_finite() {
+                    next
+                } else {
+                    0.5 * (lo + hi)
+                };
+                let moved = (next - t).abs();
+                t = next;
+                if moved <= 1e-15 * TAU {
+                    break;
+                }
+            }
+            let d = derivatives(uk, t);
+            let c = jumps(law, kappa, t, d, fundamental, nu);
+            let finite = c
+                .jumps
+                .iter()
+                .chain(&c.du_jumps)
+                .chain(&c.ddu_jumps)
+                .all(|v| v.is_finite());
+            if finite {
+                out.push(c);
+            }
+        }
+    }
+}
+
+/// `[f]`, `[f']`, `[f'']` in θ along the orbit at its crossing of `kappa` at θ, where
+/// `d = (u, u', u'', u''')` (module documentation).
+fn jumps(law: &dyn ForceLaw, kappa: f64, theta: f64, d: [f64; 4], w: f64, nu: usize) -> Crossing {
+    let delta = 1e-9 * (1.0 + kappa.abs());
+    let v = w * d[1];
+    let (v1, v2) = (w * d[2], w * d[3]);
+    let shaft = |t: f64| (nu as f64 * t).rem_euclid(TAU);
+    // D, D_u, D_v at basis angle t.
+    let diff = |t: f64| {
+        let p = shaft(t);
+        let d0 = law.force(p, kappa + delta, v) - law.force(p, kappa - delta, v);
+        let (ku, kv) = law.derivatives(p, kappa + delta, v);
+        let (lu, lv) = law.derivatives(p, kappa - delta, v);
+        [d0, ku - lu, kv - lv]
+    };
+    let eps = 1e-4;
+    let (m, c, p) = (diff(theta - eps), diff(theta), diff(theta + eps));
+    let dt = |i: usize| (p[i] - m[i]) / (2.0 * eps);
+    let dtt = (p[0] - 2.0 * c[0] + m[0]) / (eps * eps);
+    let s = d[1].signum();
+    let f0 = c[0];
+    let f1 = dt(0) + c[1] * d[1] + c[2] * v1;
+    let f2 = dtt + 2.0 * dt(1) * d[1] + 2.0 * dt(2) * v1 + c[1] * d[2] + c[2] * v2;
+    Crossing {
+        theta: theta.rem_euclid(TAU),
+        jumps: [s * f0, s * f1, s * f2],
+        du_jumps: [s * c[1], s * dt(1)],
+        ddu_jumps: [s * c[2], s * dt(2)],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `f(θ) = |cos θ - 0.3|` has kinks at `θ = ±acos 0.3`: the corrected 64-sample AFT of
+    /// harmonics 0..=8 matches the exact coefficients (from 2^16 samples plus the same
+    /// correction) to 1.3e-7 (jumps of the third and higher derivatives are left out), the
+    /// plain one is off by 4.4e-4.
+    #[test]
+    fn corrected_trapezoid_of_a_kinked_function() {
+        let f = |t: f64| (t.cos() - 0.3).abs();
+        let t0 = 0.3f64.acos();
+        // f' = -sin θ sgn(cos θ - 0.3) jumps up by 2 sin t0 at both kinks (a V); f'' = -cos θ
+        // sgn(...) jumps by +2 cos t0 at t0 and by -2 cos t0 at 2π - t0.
+        let crossings = [
+            Crossing {
+                theta: t0,
+                jumps: [0.0, 2.0 * t0.sin(), 2.0 * t0.cos()],
+                du_jumps: [0.0; 2],
+                ddu_jumps: [0.0; 2],
+            },
+            Crossing {
+                theta: TAU - t0,
+                jumps: [0.0, 2.0 * t0.sin(), -2.0 * t0.cos()],
+                du_jumps: [0.0; 2],
+                ddu_jumps: [0.0; 2],
+            },
+        ];
+        let aft = |n: usize, correct: bool| {
+            let mut x = vec![Complex64::default(); 9];
+            for (k, xk) in x.iter_mut().enumerate() {
+                let mut s = Complex64::default();
+                for j in 0..n {
+                    let t = TAU * j as f64 / n as f64;
+                    s += f(t) * Complex64::from_polar(1.0, -(k as f64) * t);
+                }
+                *xk = s * if k == 0 { 1.0 } else { 2.0 } / n as f64;
+            }
+            if correct {
+                correct_harmonics(&mut x, n, &crossings);
+            }
+            x
+        };
+        let exact = aft(1 << 16, true);
+        let (plain, fixed) = (aft(64, false), aft(64, true));
+        let err = |x: &[Complex64]| {
+            x.iter()
+                .zip(&exact)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max)
+        };
+        assert!(err(&plain) > 1e-5, "plain {}", err(&plain));
+        assert!(err(&fixed) < 1e-6, "corrected {}", err(&fixed));
+    }
+}
