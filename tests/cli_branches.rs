@@ -111,3 +111,65 @@ fn all_branches_needs_stability_and_a_speed_sweep() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--parameter"));
 }
+
+/// The period-2 orbits form a loop between the two period doublings (2.1654 and 1.8201, the
+/// reference's tongue edges): followed from the upper one, the branch comes back onto the
+/// period-1 branch at the lower one (instead of going round the loop again), and the lower
+/// doubling is not switched a second time. Swept upwards, the doublings are found although the
+/// points before them have complex multipliers only.
+#[test]
+fn period_two_loop_ends_where_it_rejoins() {
+    let s = scene();
+    let s = s.to_str().unwrap();
+    let out = hbal(&[
+        "sweep",
+        s,
+        "--from",
+        "2.3",
+        "--to",
+        "1.0",
+        "--all-branches",
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let branches = doc["branches"].as_array().unwrap();
+    assert_eq!(branches.len(), 1, "the lower doubling is the same loop");
+    let b = &branches[0];
+    assert!(
+        b["stop"].as_str().unwrap().starts_with("rejoined"),
+        "{}",
+        b["stop"]
+    );
+    let end = b["points"].as_array().unwrap().last().unwrap()["speed"]
+        .as_f64()
+        .unwrap();
+    // The reference's lower tongue edge.
+    assert!((end - 1.8201405529191677).abs() < 1e-4, "{end}");
+    let out = hbal(&[
+        "sweep",
+        s,
+        "--from",
+        "1.7",
+        "--to",
+        "2.3",
+        "--all-branches",
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let from: Vec<f64> = doc["branches"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["from_speed"].as_f64().unwrap())
+        .collect();
+    assert_eq!(from.len(), 2, "{from:?}");
+    assert!((from[0] - 1.8201405529191677).abs() < 1e-6, "{from:?}");
+    assert!((from[1] - W_PD).abs() < 1e-6, "{from:?}");
+}

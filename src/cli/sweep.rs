@@ -84,7 +84,7 @@ fn secondary_json(b: &Branch, speed: impl Fn(f64) -> f64 + Copy) -> serde_json::
         "parent_point": origin.map(|o| o.parent_point),
         "period_multiple": b.subharmonic,
         "stop": b.stop.to_string(),
-        "reached": b.stop == BranchStop::Reached,
+        "reached": b.stop.is_normal_end(),
         "folds": b.folds(),
         "points": b.points.iter().map(|p| point_json(p, b, speed)).collect::<Vec<_>>(),
     })
@@ -314,7 +314,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     }
     let failed: Vec<&Branch> = secondary
         .iter()
-        .filter(|b| b.stop != BranchStop::Reached)
+        .filter(|b| !b.stop.is_normal_end())
         .collect();
     for b in &failed {
         eprintln!(
@@ -353,10 +353,15 @@ fn secondary_line(b: &Branch, unit: &str, speed: impl Fn(f64) -> f64) -> String 
         .filter(|p| p.stable() == Some(false))
         .count();
     let end = b.points.last().map_or(String::new(), |p| {
-        format!(", ends at {} {unit}", speed(p.omega))
+        format!(", ends at {:.7} {unit}", speed(p.omega))
     });
+    let folds = match b.folds() {
+        0 => String::new(),
+        1 => ", 1 fold".to_string(),
+        f => format!(", {f} folds"),
+    };
     format!(
-        "{what}{side} from the {} at {at}{}: {} points{end}, {} unstable: {}",
+        "{what}{side} from the {} at {at}{}: {} points{end}{folds}, {} unstable: {}",
         match b.origin.as_ref().map(|o| o.bifurcation) {
             Some(hbal::stability::Bifurcation::PeriodDoubling) => "period doubling",
             _ => "branch point",

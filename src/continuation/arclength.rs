@@ -15,10 +15,17 @@ use num_complex::Complex64;
 /// `back` should it leave the range that way (a secondary branch may head either way, and
 /// turn). A branch from a solve has no `back`: past a fold it may leave the range through its
 /// start and come back (the Duffing S-curve started inside its hysteresis).
+///
+/// With `rejoin` (a mask of the unknowns that vanish on the parent branch of a switched branch:
+/// the odd harmonics below a period doubling, the even ones of a half-wave symmetric orbit), the
+/// branch also stops once it has left that subspace and comes back into it, or passes through
+/// it (its part in the mask reverses between two points): it has reached its parent again, at
+/// its other branch point, and what follows is the parent or the mirror image of what is known.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Range {
+pub(super) struct Range<'a> {
     pub(super) back: Option<f64>,
     pub(super) to: f64,
+    pub(super) rejoin: Option<&'a [bool]>,
 }
 
 impl Continuation {
@@ -107,7 +114,11 @@ impl Continuation {
             };
             return Ok(branch);
         }
-        let range = Range { back: None, to };
+        let range = Range {
+            back: None,
+            to,
+            rejoin: None,
+        };
         self.follow(&mut tr, model, &mut branch, x, from, t, range, progress);
         self.locate_bifurcations(model, basis, &mut branch)?;
         Ok(branch)
@@ -131,6 +142,7 @@ impl Continuation {
         let (from, to) = (omega, range.to);
         let direction = if to >= from { 1.0 } else { -1.0 };
         let mut step = self.initial_step;
+        let mut left_parent = false;
         let (mut xp, mut x_new) = (vec![0.0; m], vec![0.0; m]);
         let mut land_row = vec![0.0; m + 1];
         land_row[m] = 1.0;
@@ -190,6 +202,22 @@ impl Continuation {
                     landed = true;
                 }
             }
+            // Back on the parent: landed in its subspace, or passed through it (the part outside
+            // reverses, as on the mirror image or the orbit shifted by T).
+            let rejoined = range.rejoin.is_some_and(|mask| {
+                let (mut inside, mut all, mut along) = (0.0, 0.0, 0.0);
+                for i in 0..m {
+                    all += x_new[i] * x_new[i];
+                    if mask[i] {
+                        inside += x_new[i] * x_new[i];
+                        along += x_new[i] * x[i];
+                    }
+                }
+                let share = (inside / all.max(f64::MIN_POSITIVE)).sqrt();
+                let back = left_parent && (share < 1e-9 || along < 0.0);
+                left_parent |= share > 1e-6;
+                back
+            });
             // Rescale x to the new point's size, keeping the tangent's direction.
             let sx_new = tr.rms(&x_new);
             for v in t[..m].iter_mut() {
@@ -212,6 +240,10 @@ impl Continuation {
             progress(((omega - from) / (to - from)).clamp(0.0, 1.0));
             if landed || (omega - to) * direction >= 0.0 {
                 branch.stop = BranchStop::Reached;
+                break;
+            }
+            if rejoined {
+                branch.stop = BranchStop::Rejoined { omega };
                 break;
             }
             if iterations <= 2 {

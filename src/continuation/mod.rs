@@ -113,6 +113,12 @@ pub enum BranchStop {
         /// Why.
         reason: String,
     },
+    /// A switched branch came back onto its parent branch (at its other branch point or
+    /// period doubling) near this Ω: a normal end, the parent's points would follow.
+    Rejoined {
+        /// The first point back on the parent.
+        omega: f64,
+    },
     /// Branch switching found no new branch at the bifurcation.
     SwitchFailed {
         /// Why.
@@ -137,6 +143,9 @@ impl std::fmt::Display for BranchStop {
                 write!(f, "singular bordered system near Ω = {omega}")
             }
             BranchStop::SwitchFailed { reason } => write!(f, "no branch switch: {reason}"),
+            BranchStop::Rejoined { omega } => {
+                write!(f, "rejoined the parent branch near Ω = {omega}")
+            }
             BranchStop::StabilityFailed { omega, reason } => {
                 write!(f, "stability failed near Ω = {omega}: {reason}")
             }
@@ -192,8 +201,21 @@ pub struct Origin {
     pub omega: f64,
     /// The index of the parent branch's point just after it.
     pub parent_point: usize,
-    /// Which side of the parent branch (+1 or -1 along the null vector).
+    /// Which side of the parent branch (+1 or -1 along the null vector; 0 when the switch
+    /// failed).
     pub side: i8,
+    /// `max |q_i|` per DOF of the orbit at the bifurcation (where the branch leaves its
+    /// parent).
+    #[serde(default)]
+    pub max_abs: Vec<f64>,
+}
+
+impl BranchStop {
+    /// `true` for a normal end: the end of the range, or (a switched branch) back on its
+    /// parent.
+    pub fn is_normal_end(&self) -> bool {
+        matches!(self, BranchStop::Reached | BranchStop::Rejoined { .. })
+    }
 }
 
 impl Branch {

@@ -55,12 +55,24 @@ impl Continuation {
         lo: f64,
         hi: f64,
     ) -> Result<Vec<Branch>> {
-        let mut out = Vec::new();
+        let mut out: Vec<Branch> = Vec::new();
         for i in 1..parent.points.len() {
             let kind = match parent.points[i].bifurcation {
                 Some(k @ (Bifurcation::BranchPoint | Bifurcation::PeriodDoubling)) => k,
                 _ => continue,
             };
+            // A branch switched earlier that came back here is this bifurcation's branch.
+            let (a, b) = (parent.points[i - 1].omega, parent.points[i].omega);
+            let margin = 0.5 * (b - a).abs();
+            let known = out.iter().any(|br| match br.stop {
+                BranchStop::Rejoined { omega } => {
+                    omega >= a.min(b) - margin && omega <= a.max(b) + margin
+                }
+                _ => false,
+            });
+            if known {
+                continue;
+            }
             let on = match kind {
                 Bifurcation::PeriodDoubling => basis.doubled()?,
                 _ => basis,
@@ -90,6 +102,7 @@ impl Continuation {
                 omega,
                 parent_point: i,
                 side: 0,
+                max_abs: Vec::new(),
             });
             b.stop = BranchStop::SwitchFailed { reason: why.into() };
             vec![b]
@@ -117,6 +130,14 @@ impl Continuation {
             x
         };
         let (xa, xb, x_star) = (pack(&pa.harmonics), pack(&pb.harmonics), pack(&q_star));
+        let max_abs: Vec<f64> = Solution::from_harmonics(
+            parent_basis.with_omega(o_star)?,
+            model.dof_names().to_vec(),
+            q_star.clone(),
+            0.0,
+        )
+        .map(|s| (0..model.n_dofs()).map(|i| s.max_abs(i)).collect())
+        .unwrap_or_default();
         let mut tr = Tracer::new(hb, Scales::new(0.0, o_star, 1.0));
         tr.sc = Scales::new(tr.rms(&x_star), o_star, tr.load_norm());
         // The chord from a, or to b if the branch point sits on a.
@@ -137,6 +158,17 @@ impl Continuation {
                 "no second null direction at the branch point",
             ));
         };
+        // The unknowns that vanish on the parent (a symmetry it keeps): when φ lives there, the
+        // new branch has rejoined the parent once they vanish again.
+        let top = x_star.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let mask: Vec<bool> = x_star.iter().map(|v| v.abs() <= 1e-12 * top).collect();
+        let phi_inside: f64 = phi
+            .iter()
+            .zip(&mask)
+            .filter(|(_, m)| **m)
+            .map(|(v, _)| v * v)
+            .sum();
+        let rejoin = (phi_inside > 0.5).then_some(mask.as_slice());
         // 3. Both sides (one for a period doubling: the other is the same orbit shifted by T).
         let sides: &[i8] = match kind {
             Bifurcation::PeriodDoubling => &[1],
@@ -151,6 +183,7 @@ impl Continuation {
                 omega: o_star,
                 parent_point: i,
                 side,
+                max_abs: max_abs.clone(),
             });
             let dir: Vec<f64> = phi.iter().map(|v| v * f64::from(side)).collect();
             let Some((x, omega, rel)) = self.first_point(&mut tr, &x_star, o_star, &dir, step)
@@ -176,16 +209,11 @@ impl Continuation {
             }
             // Either end of the range ends it (it may leave the branch point vertically, as
             // the period-2 orbits of a linear contact do, and turn either way).
-            let range = if t_new[m] >= 0.0 {
-                Range {
-                    back: Some(lo),
-                    to: hi,
-                }
-            } else {
-                Range {
-                    back: Some(hi),
-                    to: lo,
-                }
+            let (back, to) = if t_new[m] >= 0.0 { (lo, hi) } else { (hi, lo) };
+            let range = Range {
+                back: Some(back),
+                to,
+                rejoin,
             };
             self.follow(&mut tr, model, &mut branch, x, omega, t_new, range, |_| {});
             self.locate_bifurcations(model, basis, &mut branch)?;
@@ -265,7 +293,10 @@ impl Continuation {
         let mut kept = false;
         for _ in 0..LOCATE_STEPS {
             let s = (s0 * f1 - s1 * f0) / (f1 - f0);
-            if !s.is_finite() || (s1 - s0).abs() < 1e-10 * h {
+            if !s.is_finite() {
+                return Ok(None);
+            }
+            if (s1 - s0).abs() < 1e-10 * h {
                 break;
             }
             let op = tr.sc.predict(&xa, a.omega, &chord, s, &mut xp);
@@ -276,7 +307,7 @@ impl Continuation {
                 row: &chord,
             };
             let Some((_, rel)) = self.correct(&mut tr, &mut xc, &mut oc, &target) else {
-                break;
+                return Ok(None);
             };
             let mut q = vec![Complex64::default(); tr.hb.len()];
             layout.unpack(&xc, &mut q);
@@ -292,7 +323,7 @@ impl Continuation {
                 .ok()
                 .and_then(|fl| critical_value(&fl, kind))
             else {
-                break;
+                return Ok(None);
             };
             if f.abs() < 1e-11 {
                 break;
@@ -367,12 +398,15 @@ fn null_direction(tr: &mut Tracer, x: &[f64], omega: f64, t: &mut [f64]) -> Opti
     (norm > 1e-3).then(|| v.iter().map(|a| a / norm).collect())
 }
 
-/// How far the critical multiplier of `kind` is outside the unit circle: `μ - 1` for the real
-/// multiplier nearest +1 (a branch point or fold), `-μ - 1` for the real one nearest −1 (a
-/// period doubling), `|μ| - 1` for the largest complex one (Neimark–Sacker).
+/// A test function of `kind` that changes sign where the bifurcation happens, continuous
+/// along the branch: `Π (μ_i - 1)` for a branch point or fold (zero where a real multiplier
+/// is +1; a complex pair contributes `|μ - 1|² > 0`, so a pair that turns real on the way
+/// does not hide the crossing), `Π (μ_i + 1)` for a period doubling, and `|μ| - 1` of the
+/// largest complex multiplier for a Neimark–Sacker point. Each factor is divided by
+/// `max(1, |μ_i|)` against overflow.
 fn critical_value(f: &Floquet, kind: Bifurcation) -> Option<f64> {
-    let target = match kind {
-        Bifurcation::PeriodDoubling => -1.0,
+    let shift = match kind {
+        Bifurcation::PeriodDoubling => 1.0,
         Bifurcation::NeimarkSacker => {
             return f
                 .multipliers
@@ -380,14 +414,12 @@ fn critical_value(f: &Floquet, kind: Bifurcation) -> Option<f64> {
                 .find(|m| m.im.abs() > 1e-9 * m.norm().max(1.0))
                 .map(|m| m.norm() - 1.0);
         }
-        _ => 1.0,
+        _ => -1.0,
     };
-    f.multipliers
-        .iter()
-        .filter(|m| m.im.abs() <= 1e-9 * m.norm().max(1.0))
-        .map(|m| m.re)
-        .min_by(|a, b| (a - target).abs().total_cmp(&(b - target).abs()))
-        .map(|mu| target * mu - 1.0)
+    let p = f.multipliers.iter().fold(Complex64::new(1.0, 0.0), |p, m| {
+        p * (m + shift) / m.norm().max(1.0)
+    });
+    p.re.is_finite().then_some(p.re)
 }
 
 /// The harmonics `q` (harmonic-major, `n` DOFs) of a basis with period multiple ν as harmonics

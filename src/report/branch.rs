@@ -136,6 +136,12 @@ pub fn branches_plot(
         };
         let mut current: Vec<(f64, f64)> = Vec::new();
         let mut current_stable = None;
+        // A switched branch starts at its bifurcation on the parent.
+        if let Some(o) = branch.origin.as_ref().filter(|o| o.max_abs.len() > dof) {
+            let at = (parameter(o.omega), o.max_abs[dof]);
+            current.push(at);
+            switches.push(at);
+        }
         for p in &branch.points {
             let xy = (parameter(p.parameter), p.max_abs[dof]);
             let st = p.stable();
@@ -155,15 +161,12 @@ pub fn branches_plot(
                 .filter(|p| p.fold)
                 .map(|p| (parameter(p.parameter), p.max_abs[dof])),
         );
-        if let (Some(_), Some(first)) = (&branch.origin, branch.points.first()) {
-            switches.push((parameter(first.parameter), first.max_abs[dof]));
-        }
     }
     if !folds.is_empty() {
         series.push(Series::markers("fold", folds).with_color(2));
     }
     if !switches.is_empty() {
-        series.push(Series::markers("switched branch starts", switches).with_color(2));
+        series.push(Series::markers("branch point / period doubling", switches).with_color(3));
     }
     line_plot(
         path,
