@@ -1,5 +1,5 @@
 //! `hbal sweep --all-branches`: the period-2 orbit of the gear pair's parametric resonance out
-//! of one sweep, with the period doubling located; and the bad uses of the flag.
+//! of one sweep, with the period doubling located; the bad uses of the flag; automatic harmonics.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -172,4 +172,71 @@ fn period_two_loop_ends_where_it_rejoins() {
     assert_eq!(from.len(), 2, "{from:?}");
     assert!((from[0] - 1.8201405529191677).abs() < 1e-6, "{from:?}");
     assert!((from[1] - W_PD).abs() < 1e-6, "{from:?}");
+}
+
+/// `--harmonics auto` and `harmonics = { auto = true }`: H doubled until the error estimate is
+/// below the tolerance, every level reported; bad settings name the field.
+#[test]
+fn automatic_harmonics_on_the_command_line_and_in_scenes() {
+    let backlash = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/duffing.toml");
+    let out = hbal(&[
+        "solve",
+        backlash.to_str().unwrap(),
+        "--harmonics",
+        "auto",
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let est = doc["error_estimate"]["relative"].as_f64().unwrap();
+    assert!((1e-15..=1e-6).contains(&est), "{est}");
+    assert_eq!(doc["auto_harmonics"]["reached"], true);
+    assert!(!doc["auto_harmonics"]["levels"]
+        .as_array()
+        .unwrap()
+        .is_empty());
+    let dir = std::env::temp_dir().join(format!("hbal-auto-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = |harmonics: &str| {
+        let text = std::fs::read_to_string(&backlash)
+            .unwrap()
+            .replace("harmonics = { count = 7 }", harmonics);
+        let p = dir.join("s.toml");
+        std::fs::write(&p, text).unwrap();
+        hbal(&["solve", p.to_str().unwrap(), "--no-stability"])
+    };
+    // A cap below what the tolerance needs: the last level, exit 1 and a message.
+    let out = scene("harmonics = { auto = true, count = 1, tolerance = 1e-12, max = 2 }");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("at the cap H = 2"));
+    for (bad, field) in [
+        (
+            "harmonics = { auto = true, tolerance = 0.0 }",
+            "harmonics.tolerance",
+        ),
+        (
+            "harmonics = { auto = true, tolerance = nan }",
+            "harmonics.tolerance",
+        ),
+        (
+            "harmonics = { auto = true, count = 16, max = 8 }",
+            "harmonics.max",
+        ),
+        (
+            "harmonics = { count = 7, tolerance = 1e-6 }",
+            "harmonics.tolerance",
+        ),
+        ("harmonics = { samples = 64 }", "harmonics.count"),
+    ] {
+        let out = scene(bad);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(field), "{bad}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

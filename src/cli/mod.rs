@@ -61,9 +61,10 @@ pub(crate) struct SolverArgs {
     /// Solver: fixed_point, newton, broyden, anderson (default: the scene's).
     #[arg(long)]
     pub(crate) method: Option<String>,
-    /// Number of harmonics H (default: the scene's).
+    /// Number of harmonics H, or `auto` to raise H until the estimated error is below the
+    /// scene's `harmonics.tolerance` (default 1e-6) (default: the scene's).
     #[arg(long)]
-    pub(crate) harmonics: Option<usize>,
+    pub(crate) harmonics: Option<HarmonicsArg>,
     /// Number of time samples N per period, at least 2H+1 (default: the scene's, or the
     /// default for --harmonics).
     #[arg(long)]
@@ -71,6 +72,25 @@ pub(crate) struct SolverArgs {
     /// Relative residual tolerance of the solver, in [0, 1) (default: the scene's).
     #[arg(long)]
     pub(crate) tolerance: Option<f64>,
+}
+
+/// `--harmonics`: a number, or `auto`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum HarmonicsArg {
+    Auto,
+    Count(usize),
+}
+
+impl std::str::FromStr for HarmonicsArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "auto" {
+            return Ok(HarmonicsArg::Auto);
+        }
+        s.parse::<usize>()
+            .map(HarmonicsArg::Count)
+            .map_err(|_| format!("expected a whole number of harmonics or `auto`, got `{s}`"))
+    }
 }
 
 impl SolverArgs {
@@ -102,6 +122,11 @@ pub(crate) fn load(path: &Path, args: &SolverArgs) -> Result<Scene, Failure> {
     }
     scene.method = args.with_tolerance(scene.method, &scene.file)?;
     scene.basis = basis_with(&scene.basis, args, &scene.file)?;
+    match args.harmonics {
+        Some(HarmonicsArg::Auto) => scene.auto = Some(scene.auto.unwrap_or_default()),
+        Some(HarmonicsArg::Count(_)) => scene.auto = None,
+        None => {}
+    }
     Ok(scene)
 }
 
@@ -112,7 +137,7 @@ pub(crate) fn basis_with(
     file: &str,
 ) -> Result<HarmonicBasis, Failure> {
     let mut out = *basis;
-    if let Some(h) = args.harmonics {
+    if let Some(HarmonicsArg::Count(h)) = args.harmonics {
         let b =
             HarmonicBasis::new(basis.omega(), h).with_context(|| format!("{file}: --harmonics"))?;
         // Keep the scene's N where it can still carry H harmonics.

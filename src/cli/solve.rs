@@ -47,13 +47,46 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--out: cannot create {}", dir.display()))?;
     }
-    let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
-    let mut ws = hb.workspace();
     let started = Instant::now();
-    let sol = scene
-        .method
-        .solve(&hb, start.as_ref().map(|s| s.harmonics.as_slice()), &mut ws)?;
-    let solve_seconds = started.elapsed().as_secs_f64();
+    let solve_seconds;
+    let (sol, estimate, auto) = match scene.auto {
+        Some(auto) => {
+            if start.is_some() {
+                return Err(anyhow::anyhow!(
+                    "{}: --start needs a fixed H: give --harmonics N (automatic harmonics start from the linear solution)",
+                    scene.file
+                )
+                .into());
+            }
+            let a = hbal::solve::solve_auto(&scene.model, scene.basis, &scene.method, auto)
+                .map_err(|e| Failure {
+                    code: super::exit_code(&e),
+                    error: anyhow::Error::new(e).context(scene.file.clone()),
+                })?;
+            solve_seconds = started.elapsed().as_secs_f64();
+            (
+                a.solution,
+                Some(Ok(a.estimate)),
+                Some((auto, a.levels, a.capped)),
+            )
+        }
+        None => {
+            let hb = HarmonicBalance::new(&scene.model, scene.basis)
+                .with_context(|| scene.file.clone())?;
+            let mut ws = hb.workspace();
+            let sol =
+                scene
+                    .method
+                    .solve(&hb, start.as_ref().map(|s| s.harmonics.as_slice()), &mut ws)?;
+            solve_seconds = started.elapsed().as_secs_f64();
+            // The error of the harmonics, against the solution with 2H (module
+            // hbal::solve::accuracy); none for an unconverged iterate.
+            let estimate = sol.is_converged().then(|| {
+                hbal::solve::estimate_error(&scene.model, &sol).map_err(|e| e.to_string())
+            });
+            (sol, estimate, None)
+        }
+    };
     // Stability of a converged orbit (an unconverged iterate is no orbit to judge).
     let started = Instant::now();
     let stability: Option<Result<Floquet, String>> =
@@ -100,6 +133,17 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             "iterations": sol.stats.iterations,
             "residual": sol.residual(),
             "truncation_estimate": sol.truncation_estimate(),
+            "error_estimate": match &estimate {
+                None => serde_json::Value::Null,
+                Some(Ok(e)) => json!({"relative": e.relative, "reference_harmonics": e.reference_harmonics}),
+                Some(Err(e)) => json!({"error": e}),
+            },
+            "auto_harmonics": auto.as_ref().map(|(a, levels, capped)| json!({
+                "tolerance": a.tolerance,
+                "max": a.max_harmonics,
+                "reached": !capped,
+                "levels": levels,
+            })),
             "fundamental_rad_s": sol.basis().omega(),
             "harmonics": sol.basis().harmonics(),
             "samples": sol.basis().samples(),
@@ -123,12 +167,31 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             solve_seconds * 1e3
         );
         say!(
-            "  fundamental {:.6} rad/s, H = {}, N = {}, truncation estimate {:.1e}",
+            "  fundamental {:.6} rad/s, H = {}, N = {}, {}",
             sol.basis().omega(),
             sol.basis().harmonics(),
             sol.basis().samples(),
-            sol.truncation_estimate()
+            match &estimate {
+                Some(Ok(e)) => format!(
+                    "error estimate {:.1e} (against H = {})",
+                    e.relative, e.reference_harmonics
+                ),
+                Some(Err(e)) => format!("no error estimate: {e}"),
+                None => "no error estimate (not converged)".to_string(),
+            }
         );
+        if let Some((a, levels, capped)) = &auto {
+            let steps: Vec<String> = levels
+                .iter()
+                .map(|l| format!("H = {} → {:.1e}", l.harmonics, l.estimate))
+                .collect();
+            say!(
+                "  harmonics: auto, tolerance {:.0e}{}: {}",
+                a.tolerance,
+                if *capped { " (NOT reached)" } else { "" },
+                steps.join(", ")
+            );
+        }
         for (i, name) in sol.dof_names().iter().enumerate() {
             say!("  max |q| {name}: {:.6e}", sol.max_abs(i));
         }
@@ -173,7 +236,17 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         }
     }
     let stability_failed = matches!(stability, Some(Err(_)));
-    Ok(if sol.is_converged() && !stability_failed {
+    let capped = matches!(&auto, Some((_, _, true)));
+    if let Some((a, levels, true)) = &auto {
+        eprintln!(
+            "error: {}: automatic harmonics: the estimated error {:.1e} is above the tolerance {:.0e} at the cap H = {} (harmonics.max)",
+            scene.file,
+            levels.last().map_or(f64::NAN, |l| l.estimate),
+            a.tolerance,
+            levels.last().map_or(0, |l| l.harmonics),
+        );
+    }
+    Ok(if sol.is_converged() && !stability_failed && !capped {
         0
     } else {
         1

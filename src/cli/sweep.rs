@@ -132,9 +132,26 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             );
         }
     }
-    let basis = HarmonicBasis::new(from * per, scene.basis.harmonics())?
+    let mut basis = HarmonicBasis::new(from * per, scene.basis.harmonics())?
         .with_samples(scene.basis.samples())
         .with_context(|| scene.file.clone())?;
+    // Automatic harmonics: H chosen at the first speed, then kept along the branch.
+    if let Some(auto) = scene.auto {
+        let a = hbal::solve::solve_auto(&scene.model, basis, &scene.method, auto).map_err(|e| {
+            Failure {
+                code: super::exit_code(&e),
+                error: anyhow::Error::new(e).context(scene.file.clone()),
+            }
+        })?;
+        basis = *a.solution.basis();
+        eprintln!(
+            "note: harmonics: auto, tolerance {:.0e}: H = {} (error estimate {:.1e} at {from} {unit}{}), kept along the branch",
+            auto.tolerance,
+            basis.harmonics(),
+            a.estimate.relative,
+            if a.capped { ", above the tolerance at the cap" } else { "" }
+        );
+    }
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {percent:>3}% {msg}")

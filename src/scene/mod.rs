@@ -81,8 +81,12 @@ fn one() -> f64 {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Harmonics {
-    count: usize,
+    count: Option<usize>,
     samples: Option<usize>,
+    #[serde(default)]
+    auto: bool,
+    tolerance: Option<f64>,
+    max: Option<usize>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -137,8 +141,12 @@ pub struct Scene {
     pub description: Option<String>,
     /// The model.
     pub model: Model,
-    /// Ω, H, N.
+    /// Ω, H, N (with automatic harmonics: the first H tried).
     pub basis: HarmonicBasis,
+    /// Automatic harmonics (`harmonics = { auto = true, tolerance = 1e-6 }`): H is raised from
+    /// `basis` until the estimated error is below the tolerance
+    /// ([`solve_auto`](crate::solve::solve_auto)).
+    pub auto: Option<crate::solve::AutoHarmonics>,
     /// The solver with its options.
     pub method: Method,
     /// Unit of the scene's speed (`rpm`, `hz` or `rad_s`).
@@ -468,8 +476,54 @@ impl SceneFile {
                 format!("must be finite and > 0, got {omega} rad/s"),
             ));
         }
-        let mut basis = HarmonicBasis::new(omega, self.harmonics.count)
-            .map_err(|e| err("harmonics.count", e.to_string()))?;
+        let hs = &self.harmonics;
+        let auto = if hs.auto {
+            let defaults = crate::solve::AutoHarmonics::default();
+            let tolerance = hs.tolerance.unwrap_or(defaults.tolerance);
+            if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
+                return Err(err(
+                    "harmonics.tolerance",
+                    format!("must be finite and in (0, 1), got {tolerance}"),
+                ));
+            }
+            let max_harmonics = hs.max.unwrap_or(defaults.max_harmonics);
+            let first = hs.count.unwrap_or(8);
+            if max_harmonics < first.max(1) {
+                return Err(err(
+                    "harmonics.max",
+                    format!("must be at least the first H ({first}), got {max_harmonics}"),
+                ));
+            }
+            Some(crate::solve::AutoHarmonics {
+                tolerance,
+                max_harmonics,
+            })
+        } else {
+            for (field, given) in [
+                ("tolerance", hs.tolerance.is_some()),
+                ("max", hs.max.is_some()),
+            ] {
+                if given {
+                    return Err(err(
+                        &format!("harmonics.{field}"),
+                        "only applies with `auto = true`".to_string(),
+                    ));
+                }
+            }
+            None
+        };
+        let count = match (hs.count, hs.auto) {
+            (Some(c), _) => c,
+            (None, true) => 8,
+            (None, false) => {
+                return Err(err(
+                    "harmonics.count",
+                    "is required (or `auto = true`)".to_string(),
+                ))
+            }
+        };
+        let mut basis =
+            HarmonicBasis::new(omega, count).map_err(|e| err("harmonics.count", e.to_string()))?;
         if let Some(s) = self.harmonics.samples {
             basis = basis
                 .with_samples(s)
@@ -484,6 +538,7 @@ impl SceneFile {
             description: self.description,
             model,
             basis,
+            auto,
             method,
             speed_unit,
             omega_per_speed: per_unit * f.order,

@@ -6,6 +6,7 @@
 //! rank-one updates ([`Broyden`]); [`Anderson`] accelerates the fixed-point map with the
 //! history of its last iterates. [`Method`] picks one at run time.
 
+mod accuracy;
 mod anderson;
 mod broyden;
 mod fixed_point;
@@ -16,6 +17,7 @@ mod problem;
 mod run;
 mod start;
 
+pub use accuracy::{estimate_error, solve_auto, AutoHarmonics, AutoSolution, ErrorEstimate, Level};
 pub use anderson::{Anderson, AndersonSolver};
 pub use broyden::{Broyden, BroydenSolver, InitialJacobian};
 pub use fixed_point::{FixedPoint, FixedPointSolver};
