@@ -104,6 +104,22 @@ impl SampledProfile {
         }
     }
 
+    /// The table index of mesh angle `phi`, if it sits on a tabulated angle.
+    #[inline]
+    fn index(&self, phi: f64) -> Option<usize> {
+        let n = self.values.len();
+        let x = (phi - self.phase) / self.teeth * (n as f64 / TAU);
+        let i = x.round();
+        ((x - i).abs() <= 1e-7).then(|| (i as i64).rem_euclid(n as i64) as usize)
+    }
+
+    /// The indices of `len` consecutive tabulated angles from `first` to `last`, if they are.
+    fn run(&self, first: f64, last: f64, len: usize) -> Option<impl Iterator<Item = usize>> {
+        let n = self.values.len();
+        let (a, b) = (self.index(first)?, self.index(last)?);
+        ((a + len - 1) % n == b).then(|| (a..a + len).map(move |i| i % n))
+    }
+
     #[inline]
     fn value(&self, phi: f64) -> f64 {
         let n = self.values.len();
@@ -155,6 +171,15 @@ impl MeshProfile {
     pub fn values_into(&self, z: f64, phase: f64, theta: &[f64], out: &mut [f64]) {
         debug_assert!(theta.len() <= 64 && out.len() >= theta.len());
         let n = theta.len();
+        if let MeshProfile::Sampled(table) = self {
+            // The AFT's own consecutive samples: one lookup, then a copy.
+            if let Some(run) = table.run(z * theta[0] + phase, z * theta[n - 1] + phase, n) {
+                for (o, i) in out[..n].iter_mut().zip(run) {
+                    *o = table.values[i];
+                }
+                return;
+            }
+        }
         if let (MeshProfile::Cosine { mean, amplitude }, true) = (self, n > 2) {
             let step = theta[1] - theta[0];
             let uniform = (theta[n - 1] - theta[0] - (n - 1) as f64 * step).abs()
