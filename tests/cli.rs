@@ -322,7 +322,7 @@ fn sweep_follows_the_backlash_branch_through_its_folds() {
     let csv = std::fs::read_to_string(dir.join("branch.csv")).unwrap();
     assert!(csv.starts_with("rad_s,stable,fold,bifurcation,max_abs_x,amp_x_0"));
     assert!(csv.lines().next().unwrap().ends_with(
-        ",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed"
+        ",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed,error_estimate"
     ));
     assert!(dir.join("frequency_response_x.svg").exists());
     let out = hbal(&["sweep", scene.to_str().unwrap(), "--from=-1", "--to", "1.6"]);

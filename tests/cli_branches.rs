@@ -73,7 +73,16 @@ fn all_branches_finds_the_period_two_orbit() {
             > 0.1
     );
     let csv = std::fs::read_to_string(dir.join("branch_1.csv")).unwrap();
-    assert!(csv.lines().next().unwrap().ends_with("bifurcation_speed"));
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with("bifurcation_speed,error_estimate"));
+    // Every point carries its error estimate (against 2H).
+    for p in points {
+        let e = p["error_estimate"].as_f64().unwrap();
+        assert!((1e-15..1e-2).contains(&e), "{e}");
+    }
     assert_eq!(csv.lines().count(), points.len() + 1);
     let svg = std::fs::read_to_string(dir.join("frequency_response_x.svg")).unwrap();
     assert!(

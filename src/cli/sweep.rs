@@ -55,6 +55,7 @@ fn point_json(p: &BranchPoint, branch: &Branch, speed: impl Fn(f64) -> f64) -> s
         "bifurcation_speed": p.bifurcation_omega.map(&speed),
         "residual": p.residual,
         "truncation": p.truncation,
+        "error_estimate": p.error_estimate,
         "max_abs": p.max_abs,
         "multipliers": f.map(multipliers_json),
         "multipliers_abs": f.map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
@@ -171,6 +172,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         } else {
             None
         },
+        error_estimate: true,
         ..defaults
     };
     let started = Instant::now();
@@ -265,6 +267,18 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 String::new()
             }
         );
+        let worst = branch
+            .points
+            .iter()
+            .filter_map(|p| p.error_estimate.map(|e| (e, p.omega)))
+            .max_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((e, w)) = worst {
+            say!(
+                "  largest error estimate {e:.1e} (at {:.6} {unit}; against 2H = {})",
+                speed(w),
+                2 * branch.harmonics
+            );
+        }
         let failed_start = matches!(branch.stop, BranchStop::StartFailed { .. });
         if !branch.start.is_empty() && branch.start != scene.method.name() && !failed_start {
             say!("  first point: {}", branch.start);

@@ -44,6 +44,11 @@ pub struct BranchPoint {
     /// Truncation estimate of the point ([`Solution::truncation_estimate`](crate::Solution::truncation_estimate)).
     #[serde(default)]
     pub truncation: f64,
+    /// The estimated relative error of the point's periodic solution, against the solution
+    /// with 2H harmonics ([`estimate_error`](crate::solve::estimate_error)), if asked for
+    /// ([`Continuation::error_estimate`]).
+    #[serde(default)]
+    pub error_estimate: Option<f64>,
     /// Floquet multipliers, if computed.
     pub floquet: Option<Floquet>,
     /// A turning point of the branch lies between the previous point and this one, confirmed
@@ -264,6 +269,10 @@ pub struct Continuation {
     /// How to compute the stability of every point (`None`: no stability). Default: the
     /// default [`FloquetOptions`].
     pub stability: Option<FloquetOptions>,
+    /// Estimate the error of every point against the solution with 2H harmonics (a Newton
+    /// solve there from the point: about the cost of the point's own corrector times 8 with
+    /// the dense Jacobian). Default `false`.
+    pub error_estimate: bool,
 }
 
 impl Default for Continuation {
@@ -277,6 +286,7 @@ impl Default for Continuation {
             tolerance: 1e-10,
             max_corrector: 8,
             stability: Some(FloquetOptions::default()),
+            error_estimate: false,
         }
     }
 }

@@ -67,6 +67,11 @@ impl Continuation {
         };
         let max_abs = (0..model.n_dofs()).map(|i| sol.max_abs(i)).collect();
         let truncation = sol.truncation_estimate();
+        let error_estimate = self
+            .error_estimate
+            .then(|| crate::solve::estimate_error(model, &sol).ok())
+            .flatten()
+            .map(|e| e.relative);
         branch.points.push(BranchPoint {
             parameter: p.parameter,
             omega,
@@ -74,6 +79,7 @@ impl Continuation {
             max_abs,
             residual: p.residual,
             truncation,
+            error_estimate,
             floquet,
             // Set by the caller for a turn, then [`classify_turns`] decides once the
             // neighbours are known.

@@ -35,6 +35,7 @@ pub fn solve_robustly(
     let omega = basis.omega();
     let inner = Continuation {
         stability: None,
+        error_estimate: false,
         ..*continuation
     };
     for factor in [0.5, 2.0, 0.25, 4.0] {

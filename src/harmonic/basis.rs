@@ -70,6 +70,21 @@ impl HarmonicBasis {
         Ok(self)
     }
 
+    /// The same basis with period multiple `nu` (1 ..= [`HarmonicBasis::MAX_SUBHARMONIC`]):
+    /// fundamental Ω/ν.
+    pub fn with_subharmonic(mut self, nu: usize) -> Result<Self> {
+        if !(1..=Self::MAX_SUBHARMONIC).contains(&nu) {
+            return Err(Error::invalid(
+                "harmonic basis",
+                "period multiple",
+                nu as f64,
+                format!("in 1..={}", Self::MAX_SUBHARMONIC),
+            ));
+        }
+        self.subharmonic = nu;
+        Ok(self)
+    }
+
     /// The basis of the period-doubled orbits: ν, H and N doubled, so that the harmonics of
     /// this basis are the even harmonics of the new one, resolved as finely.
     ///

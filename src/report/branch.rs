@@ -11,8 +11,8 @@ use std::path::Path;
 /// empty without stability), then the point's relative residual, its truncation estimate, the
 /// interpolated fold position (empty unless the point closes a fold) and whether a turning
 /// point of the discretised branch ends here that the multipliers do not confirm
-/// (`spurious_turn`), and the located position of a bifurcation other than a fold (empty
-/// unless the point closes one). `parameter(p)` maps the point's swept parameter and the fold position to
+/// (`spurious_turn`), the located position of a bifurcation other than a fold (empty
+/// unless the point closes one) and the point's error estimate (empty if not computed). `parameter(p)` maps the point's swept parameter and the fold position to
 /// the parameter's unit (e.g. Ω to rpm).
 pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
     let mut s = String::new();
@@ -25,7 +25,9 @@ pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64)
             let _ = write!(s, ",amp_{d}_{k}");
         }
     }
-    s.push_str(",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed\n");
+    s.push_str(
+        ",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed,error_estimate\n",
+    );
     let n = branch.dofs.len();
     for p in &branch.points {
         let stable = match p.stable() {
@@ -56,9 +58,13 @@ pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64)
             .bifurcation_omega
             .map(|w| format!("{:e}", parameter(w)))
             .unwrap_or_default();
+        let est = p
+            .error_estimate
+            .map(|e| format!("{e:e}"))
+            .unwrap_or_default();
         let _ = writeln!(
             s,
-            ",{},{:e},{:e},{fold_at},{},{bif_at}",
+            ",{},{:e},{:e},{fold_at},{},{bif_at},{est}",
             mult.join(";"),
             p.residual,
             p.truncation,

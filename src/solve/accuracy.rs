@@ -47,18 +47,7 @@ fn scaled(basis: &HarmonicBasis, harmonics: usize) -> Result<HarmonicBasis> {
     let b = HarmonicBasis::new(basis.omega(), harmonics)?;
     let per = basis.samples() as f64 / basis.harmonics().max(1) as f64;
     let n = ((per * harmonics as f64).ceil() as usize).max(b.samples());
-    let b = b.with_samples(n)?;
-    // Keep ν: rebuild by doubling from ν = 1 is not possible in general; only ν = 1 and the
-    // doubled bases of branch switching exist, and the latter are not refined here.
-    if basis.subharmonic() != 1 {
-        return Err(Error::invalid(
-            "error estimate",
-            "period multiple",
-            basis.subharmonic() as f64,
-            "1 (period-multiplied orbits are not refined)",
-        ));
-    }
-    Ok(b)
+    b.with_samples(n)?.with_subharmonic(basis.subharmonic())
 }
 
 /// Real unknowns above which the refinement tries Anderson before Newton.
