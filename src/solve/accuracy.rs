@@ -82,9 +82,17 @@ fn refine(model: &Model, solution: &Solution) -> Result<Solution> {
     }
     let sol = match sol {
         Some(s) => s,
-        None => Newton::new()
+        None if hb.len() * 2 <= crate::solve::MAX_DENSE_UNKNOWNS => Newton::new()
             .with_tolerance(1e-12)?
             .solve_from(&hb, &start, &mut ws)?,
+        None => {
+            return Err(Error::Solver {
+                reason: format!(
+                    "error estimate: Anderson did not converge with {} harmonics and the problem is too large for Newton's dense Jacobian",
+                    fine.harmonics()
+                ),
+            })
+        }
     };
     if sol.is_converged() {
         Ok(sol)
