@@ -247,5 +247,20 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(field), "{bad}: {err}");
     }
+    // A cap below the model's mesh order (20 teeth) is refused, naming the field and order.
+    let gear = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/two_shaft_gear_pair.toml"),
+    )
+    .unwrap()
+    .replace(
+        "harmonics = { count = 64 }",
+        "harmonics = { auto = true, count = 8, max = 16 }",
+    );
+    let p = dir.join("gear.toml");
+    std::fs::write(&p, gear).unwrap();
+    let out = hbal(&["solve", p.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("`max`") && err.contains(">= 20"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -111,6 +111,16 @@ impl Model {
         self.loads.iter().map(|l| l.order).max().unwrap_or(0)
     }
 
+    /// The highest order present: of any load, and of any element's time variation (a mesh
+    /// order, [`ForceLaw::time_order`](crate::force::ForceLaw::time_order)). A basis needs at
+    /// least this many harmonics.
+    pub fn max_order(&self) -> usize {
+        self.elements
+            .iter()
+            .filter_map(|e| e.law().time_order())
+            .fold(self.max_load_order(), usize::max)
+    }
+
     /// The load `f(θ)` from `(cos θ, sin θ)`, added into `out` (length n): `cos kθ`, `sin kθ`
     /// by the recurrence `e^{ikθ} = e^{iθ} e^{i(k-1)θ}` (no trigonometric call).
     pub fn load_into_phasor(&self, cos: f64, sin: f64, out: &mut [f64]) {

@@ -200,6 +200,21 @@ pub fn solve_auto(
             "finite and > 0",
         ));
     }
+    // Start with every order present (a mesh order above the first H would be refused).
+    let orders = model.max_order() * basis.subharmonic();
+    if auto.max_harmonics < orders {
+        return Err(Error::invalid(
+            "harmonics",
+            "max",
+            auto.max_harmonics as f64,
+            format!(">= {orders}, the highest load or mesh order of the model"),
+        ));
+    }
+    let mut first = basis.harmonics().max(1);
+    while first < orders {
+        first *= 2;
+    }
+    let basis = scaled(&basis, first.min(auto.max_harmonics.max(orders)))?;
     if auto.max_harmonics < basis.harmonics().max(1) {
         return Err(Error::invalid(
             "harmonics",
