@@ -84,6 +84,9 @@ enum Command {
         /// Write branch.csv and frequency_response.svg into this directory.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Skip the error estimate of every point (a solve with 2H harmonics per point).
+        #[arg(long)]
+        no_error_estimate: bool,
         /// Also follow every branch that leaves the swept one: at a branch point (symmetry
         /// breaking) both new branches, at a period doubling the period-2 orbits (harmonics
         /// of half the speed). Needs the stability; writes branch_1.csv, ... with --out.
@@ -150,6 +153,7 @@ fn main() -> ExitCode {
             out,
             max_step,
             all_branches,
+            no_error_estimate,
             parameter,
             points,
         } => match parameter {
@@ -183,6 +187,7 @@ fn main() -> ExitCode {
                     json,
                     out: out.as_deref(),
                     all_branches,
+                    error_estimate: !no_error_estimate,
                 },
             ),
         },

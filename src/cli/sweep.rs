@@ -24,6 +24,8 @@ pub(crate) struct SweepOptions<'a> {
     pub(crate) out: Option<&'a Path>,
     /// Switch to the branches leaving the main one at its branch points and period doublings.
     pub(crate) all_branches: bool,
+    /// Estimate the error of every point against 2H.
+    pub(crate) error_estimate: bool,
 }
 
 /// The branch from `basis.omega()` to `to`, from the orbit `initial` if given.
@@ -172,7 +174,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         } else {
             None
         },
-        error_estimate: true,
+        error_estimate: opts.error_estimate,
         ..defaults
     };
     let started = Instant::now();
