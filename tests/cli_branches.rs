@@ -241,6 +241,15 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
             "harmonics.tolerance",
         ),
         ("harmonics = { samples = 64 }", "harmonics.count"),
+        ("harmonics = { auto = true, count = 0 }", "harmonics.count"),
+        (
+            "harmonics = { auto = true, tolerance = 1e-300 }",
+            "harmonics.tolerance",
+        ),
+        (
+            "harmonics = { auto = true, max = 9000000000 }",
+            "harmonics.max",
+        ),
     ] {
         let out = scene(bad);
         assert_eq!(out.status.code(), Some(2), "{bad}");

@@ -345,6 +345,23 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         );
         return Ok(1);
     }
+    // Automatic harmonics chose H at the first speed: say so if the branch needs more.
+    if let Some(auto) = scene.auto {
+        let worst = branch
+            .points
+            .iter()
+            .filter_map(|p| p.error_estimate.map(|e| (e, p.omega)))
+            .max_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((e, w)) = worst.filter(|(e, _)| *e > auto.tolerance) {
+            eprintln!(
+                "warning: {}: error estimate up to {e:.1e} (at {} {unit}), above the tolerance {:.0e} of the H = {} chosen at the first speed: start the sweep there or raise harmonics.count",
+                scene.file,
+                speed(w),
+                auto.tolerance,
+                branch.harmonics
+            );
+        }
+    }
     let failed: Vec<&Branch> = secondary
         .iter()
         .filter(|b| !b.stop.is_normal_end())

@@ -480,14 +480,32 @@ impl SceneFile {
         let auto = if hs.auto {
             let defaults = crate::solve::AutoHarmonics::default();
             let tolerance = hs.tolerance.unwrap_or(defaults.tolerance);
-            if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
+            if !(tolerance.is_finite() && (1e-14..1.0).contains(&tolerance)) {
                 return Err(err(
                     "harmonics.tolerance",
-                    format!("must be finite and in (0, 1), got {tolerance}"),
+                    format!(
+                        "must be in [1e-14, 1) (the estimate stops at rounding), got {tolerance}"
+                    ),
                 ));
             }
             let max_harmonics = hs.max.unwrap_or(defaults.max_harmonics);
+            let limit = HarmonicBasis::MAX_HARMONICS / 2;
+            if max_harmonics > limit {
+                return Err(err(
+                    "harmonics.max",
+                    format!(
+                        "must be at most {limit} (its refinement doubles it), got {max_harmonics}"
+                    ),
+                ));
+            }
             let first = hs.count.unwrap_or(8);
+            if first == 0 {
+                return Err(err(
+                    "harmonics.count",
+                    "must be at least 1 with `auto = true` (H = 0 is a static analysis)"
+                        .to_string(),
+                ));
+            }
             if max_harmonics < first.max(1) {
                 return Err(err(
                     "harmonics.max",

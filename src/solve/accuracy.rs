@@ -121,6 +121,11 @@ fn refine(model: &Model, solution: &Solution) -> Result<Solution> {
 /// assert!(e.relative > 1e-6 && e.relative < 1e-1);
 /// ```
 pub fn estimate_error(model: &Model, solution: &Solution) -> Result<ErrorEstimate> {
+    if solution.basis().harmonics() == 0 {
+        return Err(Error::Solver {
+            reason: "a static analysis (H = 0) averages the time variation out: no error estimate against a dynamic solution".into(),
+        });
+    }
     let fine = refine(model, solution)?;
     Ok(compare(solution, &fine, model.n_dofs()))
 }
