@@ -315,6 +315,7 @@ impl<'m> HarmonicBalance<'m> {
                     law,
                     &act.kinks,
                     &ws.u,
+                    &ws.du,
                     &ws.uk,
                     omega,
                     self.basis.subharmonic(),
