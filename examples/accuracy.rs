@@ -10,7 +10,6 @@ mod common;
 
 use hbal::catalog::{GearBacklash, TwoShaft};
 use hbal::compare::relative_error;
-use hbal::force::{MeshDamping, MeshProfile, MeshStiffness};
 use hbal::report::{line_plot, median_time, Axis, Series};
 use hbal::solve::{estimate_error, solve_auto, AutoHarmonics, Method};
 use hbal::timesim::TimeSimulation;
@@ -44,24 +43,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (
             "contact_ratio_1.6_6000rpm",
             "two-shaft model, 6000 rpm, contact ratio 1.6 (jumps between samples)",
-            Model::builder(&["gear"])
-                .mass_diagonal(&[TwoShaft::INERTIA])
-                .element(
-                    "mesh",
-                    &[("gear", 1.0)],
-                    MeshStiffness::new(
-                        1,
-                        MeshProfile::Rectangular {
-                            one_tooth: TwoShaft::ONE_TOOTH,
-                            two_tooth: TwoShaft::TWO_TOOTH,
-                            contact_ratio: 1.6,
-                        },
-                        MeshDamping::Proportional(TwoShaft::BETA),
-                    ),
-                )
-                .load("gear", 0, TwoShaft::L0, 0.0)
-                .load("gear", 1, shaft.l1(), 0.0)
-                .build()?,
+            shaft.model_with_contact_ratio(1.6)?,
             shaft.mesh_omega(),
             None,
         ),

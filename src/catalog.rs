@@ -62,6 +62,12 @@ impl TwoShaft {
 
     /// The model (fundamental: [`TwoShaft::mesh_omega`]).
     pub fn model(&self) -> Result<Model> {
+        self.model_with_contact_ratio(Self::CONTACT_RATIO)
+    }
+
+    /// The model with another contact ratio ε in [1, 2] (1.6: the stiffness jumps fall between
+    /// the samples of every power-of-two N).
+    pub fn model_with_contact_ratio(&self, contact_ratio: f64) -> Result<Model> {
         Model::builder(&["gear"])
             .mass_diagonal(&[Self::INERTIA])
             .element(
@@ -72,7 +78,7 @@ impl TwoShaft {
                     MeshProfile::Rectangular {
                         one_tooth: Self::ONE_TOOTH,
                         two_tooth: Self::TWO_TOOTH,
-                        contact_ratio: Self::CONTACT_RATIO,
+                        contact_ratio,
                     },
                     MeshDamping::Proportional(Self::BETA),
                 ),

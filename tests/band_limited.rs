@@ -3,32 +3,13 @@
 
 use hbal::catalog::TwoShaft;
 use hbal::compare::relative_error;
-use hbal::force::{MeshDamping, MeshProfile, MeshStiffness};
 use hbal::timesim::TimeSimulation;
 use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
 
 /// The paper's two-shaft model at 6000 rpm with contact ratio 1.6 (jumps at 0 and 0.6 of the
 /// mesh cycle: off the samples of every power-of-two N).
 fn model() -> Model {
-    Model::builder(&["gear"])
-        .mass_diagonal(&[TwoShaft::INERTIA])
-        .element(
-            "mesh",
-            &[("gear", 1.0)],
-            MeshStiffness::new(
-                1,
-                MeshProfile::Rectangular {
-                    one_tooth: TwoShaft::ONE_TOOTH,
-                    two_tooth: TwoShaft::TWO_TOOTH,
-                    contact_ratio: 1.6,
-                },
-                MeshDamping::Proportional(TwoShaft::BETA),
-            ),
-        )
-        .load("gear", 0, TwoShaft::L0, 0.0)
-        .load("gear", 1, TwoShaft::new(6000.0).l1(), 0.0)
-        .build()
-        .unwrap()
+    TwoShaft::new(6000.0).model_with_contact_ratio(1.6).unwrap()
 }
 
 fn hb(model: &Model, h: usize, samples: Option<usize>) -> Vec<hbal::num_complex::Complex64> {

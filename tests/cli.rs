@@ -1,15 +1,12 @@
 //! The `hbal` binary on every example scene and on a catalogue of broken scenes, each with the
 //! message it must show and exit code 2.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn hbal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hbal"))
-        .args(args)
-        .output()
-        .expect("run hbal")
-}
+use common::hbal;
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes")

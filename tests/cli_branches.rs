@@ -1,15 +1,11 @@
 //! `hbal sweep --all-branches`: the period-2 orbit of the gear pair's parametric resonance out
 //! of one sweep, with the period doubling located; the bad uses of the flag; automatic harmonics.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn hbal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hbal"))
-        .args(args)
-        .output()
-        .expect("run hbal")
-}
+use common::hbal;
+
+use std::path::{Path, PathBuf};
 
 fn scene() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/gear_backlash_period_doubling.toml")

@@ -162,6 +162,15 @@ impl<'m> Tracer<'m> {
         (norm / (x.len() as f64).sqrt()).max(1e-12 * self.sc.ext.max(1.0))
     }
 
+    /// The unit chord from `(x, Ω)` to `(x', Ω')` in the scaled unknowns, and its length.
+    pub(super) fn chord(&self, x: &[f64], omega: f64, x2: &[f64], omega2: f64) -> (Vec<f64>, f64) {
+        let sc = self.sc;
+        let h = self.distance(x2, omega2, x, omega);
+        let mut t: Vec<f64> = x.iter().zip(x2).map(|(a, b)| (b - a) / sc.sx / h).collect();
+        t.push((omega2 - omega) / sc.so / h);
+        (t, h)
+    }
+
     /// The scaled distance between `(x, Ω)` and `(x', Ω')`.
     pub(super) fn distance(&self, x: &[f64], omega: f64, x2: &[f64], omega2: f64) -> f64 {
         let sc = self.sc;

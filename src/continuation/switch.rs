@@ -126,7 +126,10 @@ impl Continuation {
         let m = layout.len();
         let pack = |q: &[Complex64]| {
             let mut x = vec![0.0; m];
-            layout.pack(&embed(q, model.n_dofs(), ratio, basis.harmonics()), &mut x);
+            layout.pack(
+                &crate::harmonic::embed(q, model.n_dofs(), ratio, basis.harmonics()),
+                &mut x,
+            );
             x
         };
         let (xa, xb, x_star) = (pack(&pa.harmonics), pack(&pb.harmonics), pack(&q_star));
@@ -146,12 +149,7 @@ impl Continuation {
         } else {
             (&xb, pb.omega)
         };
-        let h = tr.distance(&x_star, o_star, xe, oe);
-        let mut t = vec![0.0; m + 1];
-        for k in 0..m {
-            t[k] = (x_star[k] - xe[k]) / tr.sc.sx / h;
-        }
-        t[m] = (o_star - oe) / tr.sc.so / h;
+        let (mut t, _) = tr.chord(xe, oe, &x_star, o_star);
         let Some(phi) = null_direction(&mut tr, &x_star, o_star, &mut t) else {
             return Ok(failed(
                 o_star,
@@ -277,12 +275,7 @@ impl Continuation {
         layout.pack(&b.harmonics, &mut xb);
         let mut tr = Tracer::new(hb, Scales::new(0.0, a.omega, 1.0));
         tr.sc = Scales::new(tr.rms(&xa), a.omega, tr.load_norm());
-        let h = tr.distance(&xb, b.omega, &xa, a.omega);
-        let mut chord = vec![0.0; m + 1];
-        for k in 0..m {
-            chord[k] = (xb[k] - xa[k]) / tr.sc.sx / h;
-        }
-        chord[m] = (b.omega - a.omega) / tr.sc.so / h;
+        let (chord, h) = tr.chord(&xa, a.omega, &xb, b.omega);
         let (mut s0, mut f0, mut s1, mut f1) = (0.0, fa, h, fb);
         let mut best = if fa.abs() < fb.abs() {
             (a.harmonics.clone(), a.omega)
@@ -420,17 +413,4 @@ fn critical_value(f: &Floquet, kind: Bifurcation) -> Option<f64> {
         p * (m + shift) / m.norm().max(1.0)
     });
     p.re.is_finite().then_some(p.re)
-}
-
-/// The harmonics `q` (harmonic-major, `n` DOFs) of a basis with period multiple ν as harmonics
-/// of the basis with `ratio · ν` and `h` harmonics: harmonic k becomes harmonic `ratio · k`.
-fn embed(q: &[Complex64], n: usize, ratio: usize, h: usize) -> Vec<Complex64> {
-    let mut out = vec![Complex64::default(); (h + 1) * n];
-    for (k, block) in q.chunks(n).enumerate() {
-        let k2 = k * ratio;
-        if k2 <= h {
-            out[k2 * n..(k2 + 1) * n].copy_from_slice(block);
-        }
-    }
-    out
 }

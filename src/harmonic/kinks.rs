@@ -253,48 +253,47 @@ pub fn find_crossings(
     }
 }
 
-/// The root of `u(θ) = κ` in `[lo, hi]` (the side at `lo` is `lo_above`), by Newton from `t`
-/// kept inside the shrinking bracket.
-fn root(uk: &[Complex64], kappa: f64, mut lo: f64, mut hi: f64, lo_above: bool, t: f64) -> f64 {
-    let mut t = t.clamp(lo, hi);
-    for _ in 0..60 {
+/// The root of `u(θ) = κ` in `[lo, hi]` (the side at `lo` is `lo_above`), from `t`.
+fn root(uk: &[Complex64], kappa: f64, lo: f64, hi: f64, lo_above: bool, t: f64) -> f64 {
+    let tol = 1e-14 * (1.0 + kappa.abs());
+    bracketed_newton(lo, hi, t, lo_above, tol, |t| {
         let d = derivatives(uk, t);
-        let r = d[0] - kappa;
-        if r.abs() <= 1e-14 * (1.0 + kappa.abs()) {
-            break;
-        }
-        if (r > 0.0) == lo_above {
-            lo = t;
-        } else {
-            hi = t;
-        }
-        let next = t - r / d[1];
-        let next = if next >= lo && next <= hi && next.is_finite() {
-            next
-        } else {
-            0.5 * (lo + hi)
-        };
-        let moved = (next - t).abs();
-        t = next;
-        if moved <= 1e-15 * TAU {
-            break;
-        }
-    }
-    t
+        (d[0] - kappa, d[1])
+    })
 }
 
 /// The extremum of `u` in `[lo, hi]`, where `u'` changes sign (positive at `lo` if
-/// `rising`): Newton on `u'` kept inside the bracket.
-fn extremum(uk: &[Complex64], mut lo: f64, mut hi: f64, rising: bool) -> f64 {
-    let mut t = 0.5 * (lo + hi);
-    for _ in 0..60 {
+/// `rising`).
+fn extremum(uk: &[Complex64], lo: f64, hi: f64, rising: bool) -> f64 {
+    bracketed_newton(lo, hi, 0.5 * (lo + hi), rising, 0.0, |t| {
         let d = derivatives(uk, t);
-        if (d[1] > 0.0) == rising {
+        (d[1], d[2])
+    })
+}
+
+/// The zero of `g` in `[lo, hi]` (`g > 0` at `lo` if `lo_positive`), by Newton from `t` with
+/// `f(t) = (g, g')`, kept inside the shrinking bracket (bisection where a step leaves it);
+/// stops at `|g| <= tol` or a step of 1e-15 of a period.
+fn bracketed_newton(
+    mut lo: f64,
+    mut hi: f64,
+    t: f64,
+    lo_positive: bool,
+    tol: f64,
+    f: impl Fn(f64) -> (f64, f64),
+) -> f64 {
+    let mut t = t.clamp(lo, hi);
+    for _ in 0..60 {
+        let (g, slope) = f(t);
+        if g.abs() <= tol {
+            break;
+        }
+        if (g > 0.0) == lo_positive {
             lo = t;
         } else {
             hi = t;
         }
-        let next = t - d[1] / d[2];
+        let next = t - g / slope;
         let next = if next >= lo && next <= hi && next.is_finite() {
             next
         } else {

@@ -32,3 +32,25 @@ pub fn cos_sin(q: Complex64) -> (f64, f64) {
 pub fn from_cos_sin(a: f64, b: f64) -> Complex64 {
     Complex64::new(a, -b)
 }
+
+/// The harmonics `q` (harmonic-major, `n` DOFs) placed on a basis with `h` harmonics whose
+/// fundamental is `1/ratio` of theirs: harmonic k becomes harmonic `ratio · k`; the others are
+/// zero, and harmonics beyond `h` are dropped. `ratio = 1` pads (or truncates) to `h`; `ratio =
+/// 2` embeds a T-periodic orbit in the basis of period 2T ([`HarmonicBasis::doubled`]).
+///
+/// ```
+/// use num_complex::Complex64 as C;
+/// let q = [C::new(1.0, 0.0), C::new(2.0, 0.0)];
+/// let e = hbal::harmonic::embed(&q, 1, 2, 3);
+/// assert_eq!(e, vec![C::new(1.0, 0.0), C::default(), C::new(2.0, 0.0), C::default()]);
+/// ```
+pub fn embed(q: &[Complex64], n: usize, ratio: usize, h: usize) -> Vec<Complex64> {
+    let mut out = vec![Complex64::default(); (h + 1) * n];
+    for (k, block) in q.chunks(n).enumerate() {
+        let k2 = k * ratio;
+        if k2 <= h {
+            out[k2 * n..(k2 + 1) * n].copy_from_slice(block);
+        }
+    }
+    out
+}

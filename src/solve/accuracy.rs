@@ -24,7 +24,6 @@ use crate::residual::HarmonicBalance;
 use crate::solution::Solution;
 use crate::solve::{robust_start, Method, Newton};
 use crate::HarmonicBasis;
-use num_complex::Complex64;
 use std::time::Instant;
 
 /// The estimated error of a solution.
@@ -53,14 +52,6 @@ fn scaled(basis: &HarmonicBasis, harmonics: usize) -> Result<HarmonicBasis> {
 /// Real unknowns above which the refinement tries Anderson before Newton.
 const DENSE_REFINE: usize = 600;
 
-/// `q` (harmonic-major, `n` DOFs) padded with zero harmonics to `h`.
-fn padded(q: &[Complex64], n: usize, h: usize) -> Vec<Complex64> {
-    let mut out = vec![Complex64::default(); (h + 1) * n];
-    let len = q.len().min(out.len());
-    out[..len].copy_from_slice(&q[..len]);
-    out
-}
-
 /// The refinement of `solution` on the basis with twice its harmonics (Newton from it, to a
 /// residual of 1e-12), or an error if Newton does not converge there.
 fn refine(model: &Model, solution: &Solution) -> Result<Solution> {
@@ -69,7 +60,7 @@ fn refine(model: &Model, solution: &Solution) -> Result<Solution> {
     let fine = scaled(basis, 2 * basis.harmonics().max(1))?;
     let hb = HarmonicBalance::new(model, fine)?;
     let mut ws = hb.workspace();
-    let start = padded(solution.harmonics(), n, fine.harmonics());
+    let start = crate::harmonic::embed(solution.harmonics(), n, 1, fine.harmonics());
     // From a start this close, Anderson's FFT-cost iterations beat a dense Newton step once
     // the Jacobian is large (two-shaft at H = 512: 3 ms against 60 ms); Newton is the fallback.
     let mut sol = None;
@@ -230,7 +221,6 @@ pub fn solve_auto(
     }
     let n = model.n_dofs();
     let mut level_basis = scaled(&basis, basis.harmonics().max(1))?;
-    let _ = n;
     let started = Instant::now();
     let mut hb = HarmonicBalance::new(model, level_basis)?;
     let mut ws = hb.workspace();

@@ -29,3 +29,11 @@ pub fn reference(file: &str) -> Reference {
         json,
     }
 }
+
+/// Runs the `hbal` binary of this build with `args`.
+pub fn hbal(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args(args)
+        .output()
+        .expect("run hbal")
+}
