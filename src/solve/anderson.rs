@@ -6,8 +6,11 @@
 //! for fixed-point iterations"). It keeps the cheap per-harmonic solves and needs no Jacobian;
 //! the history is cleared when the residual jumps.
 
+use super::coarse::CoarseBlock;
 use super::problem::HbProblem;
-use super::run::{check_tolerance, initial_x, run, HbSolver, HbState, Limits, Progress};
+use super::run::{
+    check_tolerance, initial_x, run_with_coarse, HbSolver, HbState, Limits, Progress,
+};
 use crate::error::{Error, Result};
 use crate::residual::{HarmonicBalance, Workspace};
 use crate::solution::{Solution, Termination};
@@ -30,6 +33,10 @@ pub struct Anderson {
     pub divergence_factor: f64,
     /// Wall-time limit, if any. Default none.
     pub timeout: Option<Duration>,
+    /// Harmonics `H_c` stepped with Newton's Jacobian (the two-level map of
+    /// [`coarse`](super::coarse)); the paper's per-harmonic map if none or `>= H`. Default none.
+    #[serde(default)]
+    pub coarse_harmonics: Option<usize>,
 }
 
 impl Default for Anderson {
@@ -41,6 +48,7 @@ impl Default for Anderson {
             tolerance: 1e-10,
             max_iterations: 200,
             timeout: None,
+            coarse_harmonics: None,
         }
     }
 }
@@ -87,6 +95,25 @@ impl Anderson {
         self
     }
 
+    /// Steps the harmonics `0..=hc` with Newton's Jacobian of the basis with `hc` harmonics
+    /// (factored once, at the start): the two-level map that makes large H cost a few dozen
+    /// FFTs. Without a warm start the solve starts from Newton's solution on that basis.
+    ///
+    /// ```
+    /// use hbal::catalog::TwoShaft;
+    /// use hbal::{Anderson, HarmonicBalance, HarmonicBasis};
+    /// let shaft = TwoShaft::new(6000.0);
+    /// let model = shaft.model()?;
+    /// let hb = HarmonicBalance::new(&model, HarmonicBasis::new(shaft.mesh_omega(), 512)?)?;
+    /// let sol = Anderson::new().with_coarse_harmonics(32).solve(&hb, &mut hb.workspace())?;
+    /// assert!(sol.is_converged() && sol.stats.iterations < 40);
+    /// # Ok::<(), hbal::Error>(())
+    /// ```
+    pub fn with_coarse_harmonics(mut self, hc: usize) -> Self {
+        self.coarse_harmonics = Some(hc);
+        self
+    }
+
     /// Solves from the linear frequency-domain solution (the paper's first iterate).
     pub fn solve(&self, hb: &HarmonicBalance, ws: &mut Workspace) -> Result<Solution> {
         self.solve_from_option(hb, None, ws)
@@ -110,13 +137,24 @@ impl Anderson {
     ) -> Result<Solution> {
         self.with_depth(self.depth)?.with_gamma(self.gamma)?;
         check_tolerance("anderson", self.tolerance)?;
-        let x0 = initial_x(hb, initial, true)?;
         let limits = Limits {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
             timeout: self.timeout,
         };
-        run(hb, ws, AndersonSolver::new(*self, x0), limits)
+        let basis = hb.basis();
+        let coarse = match self.coarse_harmonics {
+            Some(hc) if hc < basis.harmonics() => {
+                CoarseBlock::build(hb.model(), basis, hc, initial)?
+            }
+            _ => None,
+        };
+        let x0 = match (&coarse, initial) {
+            (Some((_, start)), None) => initial_x(hb, Some(start), false)?,
+            _ => initial_x(hb, initial, true)?,
+        };
+        let solver = AndersonSolver::new(*self, x0);
+        run_with_coarse(hb, ws, solver, limits, coarse.as_ref().map(|c| &c.0))
     }
 }
 

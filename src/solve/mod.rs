@@ -9,6 +9,7 @@
 mod accuracy;
 mod anderson;
 mod broyden;
+pub mod coarse;
 mod fixed_point;
 pub mod lu;
 mod method;

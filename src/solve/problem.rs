@@ -1,6 +1,7 @@
 //! The argmin problem adapter: the harmonic residual with its buffers behind a `RefCell`
 //! (argmin's problem traits take `&self`).
 
+use super::coarse::CoarseBlock;
 use crate::error::Result;
 use crate::harmonic::RealLayout;
 use crate::residual::{HarmonicBalance, Workspace};
@@ -12,6 +13,7 @@ pub struct HbProblem<'a, 'm> {
     hb: &'a HarmonicBalance<'m>,
     ws: RefCell<&'a mut Workspace>,
     ext_norm: f64,
+    coarse: Option<&'a CoarseBlock>,
 }
 
 impl<'a, 'm> HbProblem<'a, 'm> {
@@ -22,7 +24,15 @@ impl<'a, 'm> HbProblem<'a, 'm> {
             hb,
             ws: RefCell::new(ws),
             ext_norm,
+            coarse: None,
         }
+    }
+
+    /// The same problem with the two-level map: [`fixed_point_map`](Self::fixed_point_map)
+    /// steps the harmonics `0..=H_c` with the coarse Jacobian's factors.
+    pub fn with_coarse(mut self, coarse: Option<&'a CoarseBlock>) -> Self {
+        self.coarse = coarse.filter(|c| c.harmonics() < self.hb.basis().harmonics());
+        self
     }
 
     /// The discretised model.
@@ -68,7 +78,9 @@ impl<'a, 'm> HbProblem<'a, 'm> {
     }
 
     /// The paper's map `g ← G(x) = Z⁻¹ (F_ext - F_rest(x))` (steps 2a-2c, one per-harmonic solve)
-    /// and the relative residual at `x` from the same evaluation (`R = Z x - Z G(x)`).
+    /// and the relative residual at `x` from the same evaluation (`R = Z x - Z G(x)`). With a
+    /// [`CoarseBlock`] the harmonics `0..=H_c` take the step `x - J_c⁻¹ R` instead (the
+    /// two-level map of [`coarse`](super::coarse)).
     pub fn fixed_point_map(&self, x: &[f64], g: &mut [f64]) -> Result<f64> {
         let mut ws = self.ws.borrow_mut();
         let ws = &mut **ws;
@@ -80,6 +92,7 @@ impl<'a, 'm> HbProblem<'a, 'm> {
         let n = layout.n;
         let z = hb.dynamic_stiffness();
         let f_ext = hb.split_load();
+        let low = self.coarse.map(|c| (c.harmonics() + 1) * n).unwrap_or(0);
         let mut r2 = 0.0;
         for k in 0..=layout.h {
             let s = k * n..(k + 1) * n;
@@ -89,7 +102,19 @@ impl<'a, 'm> HbProblem<'a, 'm> {
                 ws.rhs[i] = f_ext[i] - ws.rest[i];
                 r2 += w * (ws.zq[i] - ws.rhs[i]).norm_sqr();
             }
-            z.solve_in_place(k, &mut ws.rhs[s]);
+            if s.start >= low {
+                z.solve_in_place(k, &mut ws.rhs[s]);
+            }
+        }
+        if let Some(c) = self.coarse {
+            // rhs ← R on the low block, then x - J_c⁻¹ R.
+            for i in 0..low {
+                ws.rhs[i] = ws.zq[i] - ws.rhs[i];
+            }
+            c.solve_in_place(&mut ws.rhs[..low]);
+            for i in 0..low {
+                ws.rhs[i] = ws.q[i] - ws.rhs[i];
+            }
         }
         layout.pack(&ws.rhs, g);
         Ok(self.relative(ws, r2.sqrt()))

@@ -1,5 +1,6 @@
 //! Running a solver with argmin's `Executor` and turning its state into a [`Solution`].
 
+use super::coarse::CoarseBlock;
 use super::problem::HbProblem;
 use crate::error::{Error, Result};
 use crate::residual::{HarmonicBalance, Workspace};
@@ -141,8 +142,22 @@ pub(crate) fn run<S>(
 where
     S: for<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> + HbSolver,
 {
+    run_with_coarse(hb, ws, solver, limits, None)
+}
+
+/// [`run`] on the two-level map of `coarse` (if any).
+pub(crate) fn run_with_coarse<S>(
+    hb: &HarmonicBalance,
+    ws: &mut Workspace,
+    solver: S,
+    limits: Limits,
+    coarse: Option<&CoarseBlock>,
+) -> Result<Solution>
+where
+    S: for<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> + HbSolver,
+{
     let start = Instant::now();
-    let problem = HbProblem::new(hb, ws);
+    let problem = HbProblem::new(hb, ws).with_coarse(coarse);
     problem.reset_stats();
     let mut executor = Executor::new(problem, solver)
         .configure(|state| {

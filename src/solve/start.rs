@@ -7,6 +7,7 @@
 //! response is nearly linear and Newton converges, and raised back to `s = 1` in steps that grow
 //! after a success and halve after a failure, each warm-started from the last.
 
+use super::coarse::coarse_harmonics;
 use super::{Anderson, Broyden, FixedPoint, Method, Newton};
 use crate::error::Result;
 use crate::residual::{HarmonicBalance, Workspace};
@@ -41,7 +42,10 @@ pub fn robust_start(
     }
     let fallbacks = [
         Method::Newton(Newton::new().with_tolerance(tolerance)?),
-        Method::Anderson(Anderson::new().with_tolerance(tolerance)?),
+        Method::Anderson(Anderson {
+            coarse_harmonics: coarse_harmonics(hb.model(), hb.basis()),
+            ..Anderson::new().with_tolerance(tolerance)?
+        }),
         Method::Broyden(Broyden::new().with_tolerance(tolerance)?),
         Method::FixedPoint(
             FixedPoint::new()
