@@ -59,6 +59,7 @@ pub mod error;
 pub mod force;
 pub mod harmonic;
 pub mod jacobian;
+pub mod linear;
 pub mod model;
 pub mod report;
 pub mod residual;
@@ -75,6 +76,7 @@ pub use model::{Element, Model};
 pub use nalgebra;
 /// The complex numbers of hbal's harmonics.
 pub use num_complex;
+pub use linear::Formulation;
 pub use residual::{AftBuffers, HarmonicBalance, Workspace};
 pub use solution::{Solution, SolveStats, Termination};
 pub use solve::{Anderson, Broyden, FixedPoint, Method, Newton};

@@ -68,6 +68,45 @@ impl DynamicStiffness {
         })
     }
 
+    /// No harmonics (a placeholder until the real one is built).
+    pub(crate) fn empty() -> Self {
+        Self {
+            n: 0,
+            matrices: Vec::new(),
+            factors: Vec::new(),
+        }
+    }
+
+    /// Factors given matrices `Z_k`, `k = 0..=H` (all `n × n`): the condensed formulation's
+    /// `G_k⁻¹` (harmonic k at `k·fundamental`). An error names the first singular harmonic.
+    pub fn from_matrices(matrices: Vec<DMatrix<Complex64>>, fundamental: f64) -> Result<Self> {
+        let n = matrices.first().map_or(0, |m| m.nrows());
+        let mut factors = Vec::with_capacity(matrices.len());
+        for (k, z) in matrices.iter().enumerate() {
+            let scale = z.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            let lu = z.clone().lu();
+            let u = lu.u();
+            let min_pivot = (0..n)
+                .map(|i| u[(i, i)].norm())
+                .fold(f64::INFINITY, f64::min);
+            let relative_pivot = if scale > 0.0 { min_pivot / scale } else { 0.0 };
+            if relative_pivot.is_nan() || relative_pivot <= SINGULAR_PIVOT {
+                return Err(Error::SingularDynamicStiffness {
+                    harmonic: k,
+                    omega: k as f64 * fundamental,
+                    relative_pivot,
+                    hint: "the condensed dynamic stiffness is singular".into(),
+                });
+            }
+            factors.push(lu);
+        }
+        Ok(Self {
+            n,
+            matrices,
+            factors,
+        })
+    }
+
     /// `Z_k`.
     pub fn matrix(&self, k: usize) -> &DMatrix<Complex64> {
         &self.matrices[k]

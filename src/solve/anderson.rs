@@ -142,11 +142,11 @@ impl Anderson {
             max_iterations: self.max_iterations,
             timeout: self.timeout,
         };
-        let basis = hb.basis();
+        // A full-DOF warm start of a condensed problem, on its coordinates.
+        let projected = initial.and_then(|q| hb.unknowns_of(q));
+        let initial = projected.as_deref().or(initial);
         let coarse = match self.coarse_harmonics {
-            Some(hc) if hc < basis.harmonics() => {
-                CoarseBlock::build(hb.model(), basis, hc, initial)?
-            }
+            Some(hc) if hc < hb.basis().harmonics() => CoarseBlock::build(hb, hc, initial)?,
             _ => None,
         };
         let x0 = match (&coarse, initial) {

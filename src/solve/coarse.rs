@@ -42,20 +42,20 @@ impl CoarseBlock {
         self.layout.h
     }
 
-    /// Builds the block for the fine `basis`: factors the Jacobian of the basis with `hc`
+    /// Builds the block for the fine problem: factors the Jacobian of the basis with `hc`
     /// harmonics at the low harmonics of `initial`, or, without one, at the solution there
     /// (chord steps from the linear solution, Newton if they stall). Returns the block and the low-harmonic start
     /// embedded in the fine basis, or `None` if the coarse Jacobian is singular.
     pub fn build(
-        model: &Model,
-        basis: &HarmonicBasis,
+        fine: &HarmonicBalance,
         hc: usize,
         initial: Option<&[Complex64]>,
     ) -> Result<Option<(Self, Vec<Complex64>)>> {
-        let n = model.n_dofs();
+        let basis = fine.basis();
+        let n = fine.layout().n;
         let coarse =
             HarmonicBasis::new(basis.omega(), hc)?.with_subharmonic(basis.subharmonic())?;
-        let hb = HarmonicBalance::new(model, coarse)?;
+        let hb = HarmonicBalance::with_formulation(fine.model(), coarse, fine.formulation())?;
         let mut ws = hb.workspace();
         let layout = hb.layout();
         let len = layout.len();

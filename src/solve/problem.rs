@@ -120,6 +120,13 @@ impl<'a, 'm> HbProblem<'a, 'm> {
         Ok(self.relative(ws, r2.sqrt()))
     }
 
+    /// The full harmonics of the unknowns `q` (see
+    /// [`HarmonicBalance::full_harmonics`]).
+    pub fn full_harmonics(&self, q: &[num_complex::Complex64]) -> Result<Vec<num_complex::Complex64>> {
+        let mut ws = self.ws.borrow_mut();
+        self.hb.full_harmonics(q, &mut ws.eval)
+    }
+
     /// Counts one solver iteration.
     pub(crate) fn count_iteration(&self) {
         self.ws.borrow_mut().stats.iterations += 1;

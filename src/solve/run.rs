@@ -115,13 +115,15 @@ pub(crate) fn initial_x(
         layout.pack(&q, &mut x);
     }
     if let Some(q) = initial {
-        if q.len() != hb.len() {
+        // A full-DOF start for a condensed problem is projected onto its coordinates.
+        let Some(q) = hb.unknowns_of(q) else {
             return Err(Error::DimensionMismatch {
                 context: "initial harmonics".into(),
                 expected: format!("{} ((H+1) * n)", hb.len()),
                 got: q.len().to_string(),
             });
-        }
+        };
+        let q = &q[..];
         if !q.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
             return Err(Error::NonFinite {
                 what: "initial harmonics".into(),
@@ -202,8 +204,9 @@ where
             reason: "argmin returned no problem".into(),
         })?;
     let stats = problem.take_stats();
-    let mut harmonics = vec![Complex64::default(); hb.len()];
-    hb.layout().unpack(&progress.x, &mut harmonics);
+    let mut unknowns = vec![Complex64::default(); hb.len()];
+    hb.layout().unpack(&progress.x, &mut unknowns);
+    let harmonics = problem.full_harmonics(&unknowns)?;
     Ok(Solution {
         basis: *hb.basis(),
         dofs: hb.model().dof_names().to_vec(),

@@ -1,0 +1,193 @@
+//! Exact condensation onto the element coordinates.
+//!
+//! Every time-varying or nonlinear element acts on one coordinate `u_e = w_e·q`. Collect the
+//! distinct coordinates (parallel weight vectors share one) as the columns of `W` (n × m).
+//! With `F_rest(Q) = W R(U)` and `U_k = Wᵀ Q_k`, the harmonic balance
+//! `Z_k Q_k + W R_k(U) = F_k` is, exactly,
+//!
+//! `G_k⁻¹ U_k + R_k(U) = G_k⁻¹ Wᵀ Z_k⁻¹ F_k`, with the receptance `G_k = Wᵀ Z_k⁻¹ W` (m × m),
+//!
+//! a harmonic balance in m unknowns per harmonic whose "dynamic stiffness" is `G_k⁻¹` (the
+//! paper's Section 3 observation: the nonlinear problem lives on the few coupling
+//! coordinates). The full `Q_k = Z_k⁻¹ (F_k - W R_k(U))` is recovered by one solve per
+//! harmonic. `Z_k` is factored by sparse LU ([`SparseDynamicStiffness`]), `m + 1` solves per
+//! harmonic build `G_k` and the condensed load.
+
+use super::sparse_stiffness::{SparseDynamicStiffness, SparsePattern};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::HarmonicBasis;
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+/// The element coordinates `W` and the factored full `Z_k`.
+#[derive(Debug)]
+pub struct Condensation {
+    /// Columns of `W`: weights over the full DOFs.
+    coordinates: Vec<Vec<(usize, f64)>>,
+    /// A name per coordinate (`u(element)`).
+    names: Vec<String>,
+    z: SparseDynamicStiffness,
+}
+
+/// The condensed linear part on one basis: `G_k⁻¹` per harmonic and the condensed load.
+#[derive(Debug, Clone)]
+pub struct CondensedLinear {
+    /// `G_k⁻¹` for `k = 0..=H` (m × m).
+    pub stiffness: Vec<DMatrix<Complex64>>,
+    /// `G_k⁻¹ Wᵀ Z_k⁻¹ F_k`, harmonic-major (`(H+1) m`).
+    pub load: Vec<Complex64>,
+}
+
+impl Condensation {
+    /// The coordinates of `element_weights` (the active elements' weights, in order) and the
+    /// sparse factors of `Z_k` on `basis`. Returns it and, per active element, its
+    /// coordinate and the factor `s` with `w_e = s · W[:, c]`.
+    pub fn new(
+        model: &Model,
+        basis: &HarmonicBasis,
+        element_weights: &[(&str, &[(usize, f64)])],
+    ) -> Result<(Self, Vec<(usize, f64)>)> {
+        let mut coordinates: Vec<Vec<(usize, f64)>> = Vec::new();
+        let mut names = Vec::new();
+        let mut map = Vec::with_capacity(element_weights.len());
+        for (name, w) in element_weights {
+            let found = coordinates
+                .iter()
+                .enumerate()
+                .find_map(|(c, v)| parallel(w, v).map(|s| (c, s)));
+            match found {
+                Some(cs) => map.push(cs),
+                None => {
+                    coordinates.push(w.to_vec());
+                    names.push(format!("u({name})"));
+                    map.push((coordinates.len() - 1, 1.0));
+                }
+            }
+        }
+        let pattern = SparsePattern::from_dense(model.mass(), &model.d0(), &model.k0());
+        let z = SparseDynamicStiffness::new(pattern, basis)?;
+        Ok((
+            Self {
+                coordinates,
+                names,
+                z,
+            },
+            map,
+        ))
+    }
+
+    /// Number of coordinates m.
+    pub fn len(&self) -> usize {
+        self.coordinates.len()
+    }
+
+    /// `true` without coordinates (a linear model).
+    pub fn is_empty(&self) -> bool {
+        self.coordinates.is_empty()
+    }
+
+    /// The coordinates' names.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Factors `Z_k` for another Ω.
+    pub fn refactor(&mut self, basis: &HarmonicBasis) -> Result<()> {
+        self.z.refactor(basis)
+    }
+
+    /// `G_k⁻¹` and the condensed load for the full load `f` (harmonic-major, `(H+1) n`).
+    pub fn linear_part(&self, f: &[Complex64]) -> Result<CondensedLinear> {
+        let (n, m) = (self.z.n(), self.len());
+        let h = self.z.harmonics();
+        let mut stiffness = Vec::with_capacity(h + 1);
+        let mut load = vec![Complex64::default(); (h + 1) * m];
+        let mut x = vec![Complex64::default(); n * (m + 1)];
+        for k in 0..=h {
+            x.fill(Complex64::default());
+            for (c, w) in self.coordinates.iter().enumerate() {
+                for &(i, wi) in w {
+                    x[c * n + i] = Complex64::new(wi, 0.0);
+                }
+            }
+            x[m * n..].copy_from_slice(&f[k * n..(k + 1) * n]);
+            self.z.solve_in_place(k, &mut x, m + 1);
+            let g = DMatrix::from_fn(m, m, |r, c| self.gather(r, &x[c * n..(c + 1) * n]));
+            let u_lin: Vec<Complex64> = (0..m)
+                .map(|r| self.gather(r, &x[m * n..(m + 1) * n]))
+                .collect();
+            let inv = g.clone().try_inverse().filter(|i| i.iter().all(|v| v.is_finite()));
+            let Some(inv) = inv else {
+                return Err(Error::Solver {
+                    reason: format!(
+                        "condensation: the receptance at harmonic {k} is singular: the element coordinates ({}) are linearly dependent; use the full formulation",
+                        self.names.join(", ")
+                    ),
+                });
+            };
+            for r in 0..m {
+                load[k * m + r] = (0..m).map(|c| inv[(r, c)] * u_lin[c]).sum();
+            }
+            stiffness.push(inv);
+        }
+        Ok(CondensedLinear { stiffness, load })
+    }
+
+    /// The full harmonics `Q_k = Z_k⁻¹ (F_k - W R_k)` from the full load `f` and the
+    /// condensed rest `rest` (`(H+1) m`).
+    pub fn recover(&self, f: &[Complex64], rest: &[Complex64]) -> Vec<Complex64> {
+        let (n, m) = (self.z.n(), self.len());
+        let h = self.z.harmonics();
+        let mut q = f.to_vec();
+        for k in 0..=h {
+            let block = &mut q[k * n..(k + 1) * n];
+            for (c, w) in self.coordinates.iter().enumerate() {
+                for &(i, wi) in w {
+                    block[i] -= rest[k * m + c] * wi;
+                }
+            }
+            self.z.solve_in_place(k, block, 1);
+        }
+        q
+    }
+
+    /// `U = Wᵀ Q` per harmonic.
+    pub fn project(&self, q: &[Complex64]) -> Vec<Complex64> {
+        let (n, m) = (self.z.n(), self.len());
+        let h = q.len() / n.max(1);
+        let mut u = vec![Complex64::default(); h * m];
+        for k in 0..h {
+            for r in 0..m {
+                u[k * m + r] = self.gather(r, &q[k * n..(k + 1) * n]);
+            }
+        }
+        u
+    }
+
+    /// `W[:, r]ᵀ x`.
+    fn gather(&self, r: usize, x: &[Complex64]) -> Complex64 {
+        self.coordinates[r]
+            .iter()
+            .fold(Complex64::default(), |acc, &(i, w)| acc + x[i] * w)
+    }
+}
+
+/// `Some(s)` if `a = s b` (same DOFs, proportional weights to 1e-12), else `None`.
+fn parallel(a: &[(usize, f64)], b: &[(usize, f64)]) -> Option<f64> {
+    let nz = |v: &[(usize, f64)]| -> Vec<(usize, f64)> {
+        let mut v: Vec<_> = v.iter().copied().filter(|(_, w)| *w != 0.0).collect();
+        v.sort_by_key(|(i, _)| *i);
+        v
+    };
+    let (a, b) = (nz(a), nz(b));
+    if a.len() != b.len() || a.is_empty() {
+        return None;
+    }
+    let s = a[0].1 / b[0].1;
+    let scale = a.iter().map(|(_, w)| w.abs()).fold(0.0, f64::max);
+    a.iter()
+        .zip(&b)
+        .all(|((ia, wa), (ib, wb))| ia == ib && (wa - s * wb).abs() <= 1e-12 * scale)
+        .then_some(s)
+}

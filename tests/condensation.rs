@@ -1,0 +1,145 @@
+//! The exact condensation onto the element coordinates against the full formulation: the
+//! same periodic solution to 1e-10 on the example scenes and on a torsional chain with two
+//! gear meshes (mesh stiffness and backlash on one coordinate each), for Newton and for the
+//! two-level Anderson map.
+
+use hbal::compare::relative_error;
+use hbal::force::{Backlash, MeshDamping, MeshProfile, MeshStiffness};
+use hbal::nalgebra::DMatrix;
+use hbal::scene::Scene;
+use hbal::{Anderson, Formulation, HarmonicBalance, HarmonicBasis, Model, Newton, Solution};
+
+fn solve(model: &Model, basis: HarmonicBasis, formulation: Formulation) -> Solution {
+    let hb = HarmonicBalance::with_formulation(model, basis, formulation).unwrap();
+    let sol = Newton::new()
+        .with_tolerance(1e-13)
+        .unwrap()
+        .solve(&hb, &mut hb.workspace())
+        .unwrap();
+    assert!(sol.is_converged(), "{formulation:?}: {}", sol.termination);
+    sol
+}
+
+/// Every example scene with a nonlinear or time-varying element (H reduced to at most 32):
+/// condensed and full agree to 1e-10.
+#[test]
+fn condensed_equals_full_on_the_example_scenes() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let scene = Scene::load(&path).unwrap();
+        let h = scene.basis.harmonics().min(32);
+        let basis = HarmonicBasis::new(scene.basis.omega(), h)
+            .unwrap()
+            .with_subharmonic(scene.basis.subharmonic())
+            .unwrap();
+        let full = solve(&scene.model, basis, Formulation::Full);
+        let cond = solve(&scene.model, basis, Formulation::Condensed);
+        let n = scene.model.n_dofs();
+        let d = relative_error(cond.harmonics(), full.harmonics(), n, h);
+        assert!(d < 1e-10, "{}: condensed against full {d:.1e}", path.display());
+        assert_eq!(cond.dof_names(), full.dof_names());
+        checked += 1;
+    }
+    assert!(checked >= 8, "{checked} scenes");
+}
+
+/// A 7-DOF chain: engine, flywheel, input shaft, gear 1 | gear 2, output, wheel; two meshes,
+/// each a rectangular mesh stiffness and a backlash element on the same coordinate (so m = 2
+/// coordinates for 3 elements), grounded by a soft spring, driven by a torque of order 1.
+fn chain() -> Model {
+    let names = ["engine", "flywheel", "shaft", "g1", "g2", "out", "wheel"];
+    let inertia = [0.2, 0.5, 0.01, 0.002, 0.004, 0.02, 1.0];
+    let n = names.len();
+    let mut k = DMatrix::zeros(n, n);
+    let mut spring = |i: usize, j: usize, c: f64| {
+        k[(i, i)] += c;
+        k[(j, j)] += c;
+        k[(i, j)] -= c;
+        k[(j, i)] -= c;
+    };
+    spring(0, 1, 2e4);
+    spring(1, 2, 5e3);
+    spring(2, 3, 8e3);
+    spring(4, 5, 6e3);
+    spring(5, 6, 3e3);
+    k[(6, 6)] += 50.0;
+    k[(0, 0)] += 50.0;
+    let d = &k * 2e-4;
+    let profile = MeshProfile::Rectangular {
+        one_tooth: 2e5,
+        two_tooth: 3e5,
+        contact_ratio: 1.4,
+    };
+    let (r1, r2) = (0.03, 0.05);
+    Model::builder(&names)
+        .mass_diagonal(&inertia)
+        .stiffness(k)
+        .damping(d)
+        .element(
+            "mesh",
+            &[("g1", r1), ("g2", r2)],
+            MeshStiffness::new(1, profile.clone(), MeshDamping::Constant(20.0)),
+        )
+        .element(
+            "backlash",
+            &[("g1", -r1), ("g2", -r2)],
+            Backlash::new(1e-5, MeshProfile::Constant { stiffness: 1e4 }),
+        )
+        .element(
+            "clutch",
+            &[("shaft", 2.0), ("flywheel", -2.0)],
+            Backlash::new(0.01, MeshProfile::Constant { stiffness: 500.0 }),
+        )
+        .load("engine", 0, 20.0, 0.0)
+        .load("engine", 1, 30.0, 10.0)
+        .load("wheel", 0, -20.0 * r2 / r1, 0.0)
+        .build()
+        .unwrap()
+}
+
+#[test]
+fn condensed_equals_full_on_a_two_mesh_chain() {
+    let model = chain();
+    let basis = HarmonicBasis::new(300.0, 24).unwrap();
+    let full = solve(&model, basis, Formulation::Full);
+    let hb = HarmonicBalance::with_formulation(&model, basis, Formulation::Condensed).unwrap();
+    assert_eq!(hb.unknown_names(), ["u(mesh)", "u(clutch)"]);
+    assert_eq!(hb.layout().n, 2);
+    let cond = solve(&model, basis, Formulation::Condensed);
+    let d = relative_error(cond.harmonics(), full.harmonics(), 7, 24);
+    assert!(d < 1e-10, "condensed against full {d:.1e}");
+    // The two-level Anderson map on the condensed problem, from a full-DOF warm start.
+    let anderson = Anderson::new()
+        .with_tolerance(1e-13)
+        .unwrap()
+        .with_coarse_harmonics(8);
+    let a = anderson
+        .solve_from(&hb, full.harmonics(), &mut hb.workspace())
+        .unwrap();
+    assert!(a.is_converged(), "{}", a.termination);
+    let d = relative_error(a.harmonics(), full.harmonics(), 7, 24);
+    assert!(d < 1e-10, "two-level condensed against full {d:.1e}");
+}
+
+/// A model without a nonlinear element has nothing to condense onto: a clear error.
+#[test]
+fn condensing_a_linear_model_is_an_error() {
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .stiffness(DMatrix::from_element(1, 1, 4.0))
+        .load("x", 1, 1.0, 0.0)
+        .build()
+        .unwrap();
+    let err = HarmonicBalance::with_formulation(
+        &model,
+        HarmonicBasis::new(1.3, 4).unwrap(),
+        Formulation::Condensed,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("no time-varying or nonlinear element"), "{err}");
+}
