@@ -71,12 +71,12 @@ pub mod timesim;
 
 pub use error::{Error, Result};
 pub use harmonic::HarmonicBasis;
+pub use linear::Formulation;
 pub use model::{Element, Model};
 /// The linear-algebra crate of hbal's API (matrices of [`Model`]).
 pub use nalgebra;
 /// The complex numbers of hbal's harmonics.
 pub use num_complex;
-pub use linear::Formulation;
 pub use residual::{AftBuffers, HarmonicBalance, Workspace};
 pub use solution::{Solution, SolveStats, Termination};
 pub use solve::{Anderson, Broyden, FixedPoint, Method, Newton};

@@ -41,7 +41,11 @@ fn condensed_equals_full_on_the_example_scenes() {
         let cond = solve(&scene.model, basis, Formulation::Condensed);
         let n = scene.model.n_dofs();
         let d = relative_error(cond.harmonics(), full.harmonics(), n, h);
-        assert!(d < 1e-10, "{}: condensed against full {d:.1e}", path.display());
+        assert!(
+            d < 1e-10,
+            "{}: condensed against full {d:.1e}",
+            path.display()
+        );
         assert_eq!(cond.dof_names(), full.dof_names());
         checked += 1;
     }
@@ -141,5 +145,9 @@ fn condensing_a_linear_model_is_an_error() {
         Formulation::Condensed,
     )
     .unwrap_err();
-    assert!(err.to_string().contains("no time-varying or nonlinear element"), "{err}");
+    assert!(
+        err.to_string()
+            .contains("no time-varying or nonlinear element"),
+        "{err}"
+    );
 }

@@ -117,7 +117,10 @@ impl Condensation {
             let u_lin: Vec<Complex64> = (0..m)
                 .map(|r| self.gather(r, &x[m * n..(m + 1) * n]))
                 .collect();
-            let inv = g.clone().try_inverse().filter(|i| i.iter().all(|v| v.is_finite()));
+            let inv = g
+                .clone()
+                .try_inverse()
+                .filter(|i| i.iter().all(|v| v.is_finite()));
             let Some(inv) = inv else {
                 return Err(Error::Solver {
                     reason: format!(

@@ -33,7 +33,8 @@ impl SparsePattern {
     pub fn from_dense(m: &DMatrix<f64>, d: &DMatrix<f64>, k: &DMatrix<f64>) -> Self {
         let n = m.nrows();
         let mut col_ptr = Vec::with_capacity(n + 1);
-        let (mut row_idx, mut mv, mut dv, mut kv) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut row_idx, mut mv, mut dv, mut kv) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         col_ptr.push(0);
         for j in 0..n {
             for i in 0..n {
@@ -121,11 +122,10 @@ impl SparseDynamicStiffness {
     /// Analyses the pattern once and factors `Z_k` for every harmonic of `basis`; an error
     /// names the first singular harmonic.
     pub fn new(pattern: SparsePattern, basis: &HarmonicBasis) -> Result<Self> {
-        let symbolic = SymbolicLu::try_new(pattern.symbolic().as_ref()).map_err(|e| {
-            Error::Solver {
+        let symbolic =
+            SymbolicLu::try_new(pattern.symbolic().as_ref()).map_err(|e| Error::Solver {
                 reason: format!("sparse LU analysis of the dynamic stiffness: {e:?}"),
-            }
-        })?;
+            })?;
         let mut s = Self {
             pattern,
             symbolic,
@@ -209,7 +209,6 @@ impl SparseDynamicStiffness {
 
     /// `out ← Z_k x`.
     pub fn apply(&self, k: usize, x: &[Complex64], out: &mut [Complex64]) {
-        self.pattern
-            .apply(k as f64 * self.fundamental, x, out);
+        self.pattern.apply(k as f64 * self.fundamental, x, out);
     }
 }

@@ -17,6 +17,8 @@ pub struct ModelBuilder {
     stiffness: Option<DMatrix<f64>>,
     loads: Vec<(String, usize, f64, f64)>,
     elements: Vec<PendingElement>,
+    /// The first triplet outside the DOFs: matrix, row, column.
+    bad_triplet: Option<(&'static str, usize, usize)>,
 }
 
 impl ModelBuilder {
@@ -28,6 +30,7 @@ impl ModelBuilder {
             stiffness: None,
             loads: Vec::new(),
             elements: Vec::new(),
+            bad_triplet: None,
         }
     }
 
@@ -55,6 +58,55 @@ impl ModelBuilder {
     pub fn stiffness(mut self, k: DMatrix<f64>) -> Self {
         self.stiffness = Some(k);
         self
+    }
+
+    /// Mass matrix M from `(row, column, value)` triplets (DOF indices from 0; repeated
+    /// positions add up, as in FE assembly). For large sparse models.
+    ///
+    /// ```
+    /// use hbal::Model;
+    /// let m = Model::builder(&["a", "b"])
+    ///     .mass_triplets(&[(0, 0, 1.0), (1, 1, 2.0)])
+    ///     .stiffness_triplets(&[(0, 0, 1.0), (0, 0, 1.0), (0, 1, -1.0), (1, 0, -1.0), (1, 1, 1.0)])
+    ///     .build()?;
+    /// assert_eq!(m.k0()[(0, 0)], 2.0);
+    /// let err = Model::builder(&["a"]).mass_triplets(&[(0, 3, 1.0)]).build().unwrap_err();
+    /// assert!(err.to_string().contains("(0, 3)"));
+    /// # Ok::<(), hbal::Error>(())
+    /// ```
+    pub fn mass_triplets(mut self, triplets: &[(usize, usize, f64)]) -> Self {
+        self.mass = self.assemble(triplets, "mass");
+        self
+    }
+
+    /// Structural damping D from triplets (see [`ModelBuilder::mass_triplets`]).
+    pub fn damping_triplets(mut self, triplets: &[(usize, usize, f64)]) -> Self {
+        self.damping = self.assemble(triplets, "damping");
+        self
+    }
+
+    /// Structural stiffness K from triplets (see [`ModelBuilder::mass_triplets`]).
+    pub fn stiffness_triplets(mut self, triplets: &[(usize, usize, f64)]) -> Self {
+        self.stiffness = self.assemble(triplets, "stiffness");
+        self
+    }
+
+    /// Assembles triplets; an index outside the DOFs is kept for `build` to report.
+    fn assemble(
+        &mut self,
+        triplets: &[(usize, usize, f64)],
+        what: &'static str,
+    ) -> Option<DMatrix<f64>> {
+        let n = self.dofs.len();
+        let mut m = DMatrix::zeros(n, n);
+        for &(i, j, v) in triplets {
+            if i >= n || j >= n {
+                self.bad_triplet.get_or_insert((what, i, j));
+                continue;
+            }
+            m[(i, j)] += v;
+        }
+        Some(m)
     }
 
     /// Adds `cos · cos(k Ω t) + sin · sin(k Ω t)` to the load on `dof` (k = 0: static).
@@ -104,6 +156,13 @@ impl ModelBuilder {
                     reason: format!("DOF name `{d}` appears twice"),
                 });
             }
+        }
+        if let Some((what, i, j)) = self.bad_triplet {
+            return Err(Error::DimensionMismatch {
+                context: format!("{what} matrix triplet ({i}, {j})"),
+                expected: format!("row and column indices below {n}, the number of DOFs"),
+                got: format!("({i}, {j})"),
+            });
         }
         let known = self.dofs.join(", ");
         let index = |context: &str, name: &str| -> Result<usize> {

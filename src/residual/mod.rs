@@ -21,8 +21,6 @@ use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 
-
-
 /// `out += w f` over the unknowns of `weights`.
 #[inline]
 fn scatter_add(weights: &[(usize, f64)], f: Complex64, out: &mut [Complex64]) {
@@ -275,11 +273,7 @@ impl<'m> HarmonicBalance<'m> {
 
     /// Buffers for one solve at a time.
     pub fn workspace(&self) -> Workspace {
-        let (h, n, s) = (
-            self.basis.harmonics(),
-            self.n,
-            self.basis.samples(),
-        );
+        let (h, n, s) = (self.basis.harmonics(), self.n, self.basis.samples());
         let len = (h + 1) * n;
         Workspace {
             eval: AftBuffers {

@@ -122,7 +122,10 @@ impl<'a, 'm> HbProblem<'a, 'm> {
 
     /// The full harmonics of the unknowns `q` (see
     /// [`HarmonicBalance::full_harmonics`]).
-    pub fn full_harmonics(&self, q: &[num_complex::Complex64]) -> Result<Vec<num_complex::Complex64>> {
+    pub fn full_harmonics(
+        &self,
+        q: &[num_complex::Complex64],
+    ) -> Result<Vec<num_complex::Complex64>> {
         let mut ws = self.ws.borrow_mut();
         self.hb.full_harmonics(q, &mut ws.eval)
     }
