@@ -65,7 +65,7 @@ impl Condensation {
                 }
             }
         }
-        let pattern = SparsePattern::from_dense(model.mass(), &model.d0(), &model.k0());
+        let pattern = SparsePattern::new(model.mass(), &model.d0(), &model.k0());
         let z = SparseDynamicStiffness::new(pattern, basis)?;
         Ok((
             Self {

@@ -8,12 +8,12 @@
 //! [`DynamicStiffness`](crate::harmonic::DynamicStiffness) costs `n³/3`.
 
 use crate::error::{Error, Result};
+use crate::model::SparseMatrix;
 use crate::HarmonicBasis;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::MatMut;
-use nalgebra::DMatrix;
 use num_complex::Complex64;
 
 /// The pattern of `M`, `D0`, `K0` in compressed columns, with their values at each position.
@@ -28,25 +28,41 @@ pub struct SparsePattern {
 }
 
 impl SparsePattern {
-    /// The union of the nonzeros of three dense `n × n` matrices (and the diagonal, so that a
-    /// structurally empty row is a clear singular error rather than a missing pivot).
-    pub fn from_dense(m: &DMatrix<f64>, d: &DMatrix<f64>, k: &DMatrix<f64>) -> Self {
-        let n = m.nrows();
-        let mut col_ptr = Vec::with_capacity(n + 1);
+    /// The union of the nonzeros of `M`, `D0`, `K0` (and the diagonal, so that a structurally
+    /// empty row is a clear singular error rather than a missing pivot).
+    pub fn new(m: &SparseMatrix, d: &SparseMatrix, k: &SparseMatrix) -> Self {
+        let n = m.n();
+        // Tag each entry with its matrix, merge by position.
+        let mut t: Vec<(usize, usize, u8, f64)> =
+            Vec::with_capacity(m.nnz() + d.nnz() + k.nnz() + n);
+        for (tag, a) in [(0u8, m), (1, d), (2, k)] {
+            t.extend(a.iter().map(|(i, j, v)| (i, j, tag, v)));
+        }
+        t.extend((0..n).map(|i| (i, i, 3, 0.0)));
+        t.sort_unstable_by_key(|&(i, j, _, _)| (j, i));
+        let mut col_ptr = vec![0; n + 1];
         let (mut row_idx, mut mv, mut dv, mut kv) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        col_ptr.push(0);
-        for j in 0..n {
-            for i in 0..n {
-                let (a, b, c) = (m[(i, j)], d[(i, j)], k[(i, j)]);
-                if a != 0.0 || b != 0.0 || c != 0.0 || i == j {
-                    row_idx.push(i);
-                    mv.push(a);
-                    dv.push(b);
-                    kv.push(c);
-                }
+        let mut last = None;
+        for (i, j, tag, v) in t {
+            if last != Some((i, j)) {
+                last = Some((i, j));
+                row_idx.push(i);
+                mv.push(0.0);
+                dv.push(0.0);
+                kv.push(0.0);
+                col_ptr[j + 1] += 1;
             }
-            col_ptr.push(row_idx.len());
+            let p = row_idx.len() - 1;
+            match tag {
+                0 => mv[p] += v,
+                1 => dv[p] += v,
+                2 => kv[p] += v,
+                _ => {}
+            }
+        }
+        for j in 0..n {
+            col_ptr[j + 1] += col_ptr[j];
         }
         Self {
             n,
@@ -211,4 +227,19 @@ impl SparseDynamicStiffness {
     pub fn apply(&self, k: usize, x: &[Complex64], out: &mut [Complex64]) {
         self.pattern.apply(k as f64 * self.fundamental, x, out);
     }
+}
+
+/// `true` if the symmetric `a` is positive definite (sparse Cholesky of its lower triangle
+/// succeeds).
+pub fn is_positive_definite(a: &SparseMatrix) -> bool {
+    use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+    use faer::Side;
+    let (col_ptr, row_idx, values) = a.parts();
+    let structure =
+        SymbolicSparseColMat::new_checked(a.n(), a.n(), col_ptr.to_vec(), None, row_idx.to_vec());
+    let Ok(symbolic) = SymbolicLlt::try_new(structure.as_ref(), Side::Lower) else {
+        return false;
+    };
+    let mat = SparseColMat::new(structure, values.to_vec());
+    Llt::try_new_with_symbolic(symbolic, mat.as_ref(), Side::Lower).is_ok()
 }

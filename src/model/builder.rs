@@ -1,6 +1,6 @@
 //! Validating builder for [`Model`].
 
-use super::{Element, Load, Model};
+use super::{Element, Load, Model, SparseMatrix};
 use crate::error::{Error, Result};
 use crate::force::ForceLaw;
 use nalgebra::DMatrix;
@@ -8,13 +8,20 @@ use nalgebra::DMatrix;
 /// An element as given: name, `(DOF name, weight)` pairs, law.
 type PendingElement = (String, Vec<(String, f64)>, Box<dyn ForceLaw>);
 
+/// A matrix as given: dense, or assembled from triplets.
+#[derive(Debug, Clone)]
+enum Input {
+    Dense(DMatrix<f64>),
+    Sparse(SparseMatrix),
+}
+
 /// Collects a model's parts; [`ModelBuilder::build`] validates them all.
 #[derive(Debug)]
 pub struct ModelBuilder {
     dofs: Vec<String>,
-    mass: Option<DMatrix<f64>>,
-    damping: Option<DMatrix<f64>>,
-    stiffness: Option<DMatrix<f64>>,
+    mass: Option<Input>,
+    damping: Option<Input>,
+    stiffness: Option<Input>,
     loads: Vec<(String, usize, f64, f64)>,
     elements: Vec<PendingElement>,
     /// The first triplet outside the DOFs: matrix, row, column.
@@ -36,7 +43,7 @@ impl ModelBuilder {
 
     /// Mass matrix M (n × n, symmetric positive definite). Required.
     pub fn mass(mut self, m: DMatrix<f64>) -> Self {
-        self.mass = Some(m);
+        self.mass = Some(Input::Dense(m));
         self
     }
 
@@ -50,13 +57,13 @@ impl ModelBuilder {
 
     /// Structural damping D (n × n), default zero.
     pub fn damping(mut self, d: DMatrix<f64>) -> Self {
-        self.damping = Some(d);
+        self.damping = Some(Input::Dense(d));
         self
     }
 
     /// Structural stiffness K (n × n), default zero.
     pub fn stiffness(mut self, k: DMatrix<f64>) -> Self {
-        self.stiffness = Some(k);
+        self.stiffness = Some(Input::Dense(k));
         self
     }
 
@@ -69,7 +76,7 @@ impl ModelBuilder {
     ///     .mass_triplets(&[(0, 0, 1.0), (1, 1, 2.0)])
     ///     .stiffness_triplets(&[(0, 0, 1.0), (0, 0, 1.0), (0, 1, -1.0), (1, 0, -1.0), (1, 1, 1.0)])
     ///     .build()?;
-    /// assert_eq!(m.k0()[(0, 0)], 2.0);
+    /// assert_eq!(m.k0().get(0, 0), 2.0);
     /// let err = Model::builder(&["a"]).mass_triplets(&[(0, 3, 1.0)]).build().unwrap_err();
     /// assert!(err.to_string().contains("(0, 3)"));
     /// # Ok::<(), hbal::Error>(())
@@ -92,21 +99,17 @@ impl ModelBuilder {
     }
 
     /// Assembles triplets; an index outside the DOFs is kept for `build` to report.
-    fn assemble(
-        &mut self,
-        triplets: &[(usize, usize, f64)],
-        what: &'static str,
-    ) -> Option<DMatrix<f64>> {
+    fn assemble(&mut self, triplets: &[(usize, usize, f64)], what: &'static str) -> Option<Input> {
         let n = self.dofs.len();
-        let mut m = DMatrix::zeros(n, n);
-        for &(i, j, v) in triplets {
-            if i >= n || j >= n {
-                self.bad_triplet.get_or_insert((what, i, j));
-                continue;
-            }
-            m[(i, j)] += v;
+        if let Some(&(i, j, _)) = triplets.iter().find(|(i, j, _)| *i >= n || *j >= n) {
+            self.bad_triplet.get_or_insert((what, i, j));
         }
-        Some(m)
+        let inside: Vec<_> = triplets
+            .iter()
+            .copied()
+            .filter(|(i, j, _)| *i < n && *j < n)
+            .collect();
+        Some(Input::Sparse(SparseMatrix::from_triplets(n, &inside)))
     }
 
     /// Adds `cos · cos(k Ω t) + sin · sin(k Ω t)` to the load on `dof` (k = 0: static).
@@ -176,21 +179,23 @@ impl ModelBuilder {
                 })
         };
 
-        let mass = self
-            .mass
-            .clone()
-            .ok_or_else(|| Error::MassNotPositiveDefinite {
-                reason: "no mass matrix given".into(),
-            })?;
-        check_matrix("mass matrix", &mass, n)?;
+        let mass = match self.mass.clone() {
+            Some(m) => check_matrix("mass matrix", m, n)?,
+            None => {
+                return Err(Error::MassNotPositiveDefinite {
+                    reason: "no mass matrix given".into(),
+                })
+            }
+        };
         check_spd(&mass)?;
-        let damping = self.damping.clone().unwrap_or_else(|| DMatrix::zeros(n, n));
-        check_matrix("damping matrix", &damping, n)?;
-        let stiffness = self
-            .stiffness
-            .clone()
-            .unwrap_or_else(|| DMatrix::zeros(n, n));
-        check_matrix("stiffness matrix", &stiffness, n)?;
+        let damping = match self.damping.clone() {
+            Some(d) => check_matrix("damping matrix", d, n)?,
+            None => SparseMatrix::zeros(n),
+        };
+        let stiffness = match self.stiffness.clone() {
+            Some(k) => check_matrix("stiffness matrix", k, n)?,
+            None => SparseMatrix::zeros(n),
+        };
 
         let mut loads = Vec::with_capacity(self.loads.len());
         for (dof, order, c, s) in &self.loads {
@@ -251,34 +256,45 @@ impl ModelBuilder {
     }
 }
 
-fn check_matrix(context: &str, m: &DMatrix<f64>, n: usize) -> Result<()> {
-    if m.nrows() != n || m.ncols() != n {
-        return Err(Error::DimensionMismatch {
-            context: context.into(),
-            expected: format!("{n} x {n} (one row and column per DOF)"),
-            got: format!("{} x {}", m.nrows(), m.ncols()),
-        });
+/// Checks the size and the entries of a matrix and stores it sparse.
+fn check_matrix(context: &str, m: Input, n: usize) -> Result<SparseMatrix> {
+    let m = match m {
+        Input::Dense(m) => {
+            if m.nrows() != n || m.ncols() != n {
+                return Err(Error::DimensionMismatch {
+                    context: context.into(),
+                    expected: format!("{n} x {n} (one row and column per DOF)"),
+                    got: format!("{} x {}", m.nrows(), m.ncols()),
+                });
+            }
+            if let Some(((i, j), v)) = m
+                .iter()
+                .enumerate()
+                .map(|(idx, v)| ((idx % n, idx / n), v))
+                .find(|(_, v)| !v.is_finite())
+            {
+                return Err(Error::invalid(context, format!("[{i}][{j}]"), *v, "finite"));
+            }
+            SparseMatrix::from_dense(&m)
+        }
+        Input::Sparse(m) => m,
+    };
+    if let Some((i, j, v)) = m.first_non_finite() {
+        return Err(Error::invalid(context, format!("[{i}][{j}]"), v, "finite"));
     }
-    if let Some(((i, j), v)) = m
-        .iter()
-        .enumerate()
-        .map(|(idx, v)| ((idx % n, idx / n), v))
-        .find(|(_, v)| !v.is_finite())
-    {
-        return Err(Error::invalid(context, format!("[{i}][{j}]"), *v, "finite"));
-    }
-    Ok(())
+    Ok(m)
 }
 
-fn check_spd(m: &DMatrix<f64>) -> Result<()> {
+/// Symmetric (to 1e-12 of its largest entry) and positive definite (sparse Cholesky).
+fn check_spd(m: &SparseMatrix) -> Result<()> {
     let scale = m.amax();
-    let asym = (m - m.transpose()).amax();
+    let asym = m.asymmetry();
     if asym > 1e-12 * scale {
         return Err(Error::MassNotPositiveDefinite {
             reason: format!("not symmetric (largest |M - Mᵀ| entry {asym:.3e})"),
         });
     }
-    if m.clone().cholesky().is_none() || scale == 0.0 {
+    if scale == 0.0 || !crate::linear::sparse_stiffness::is_positive_definite(m) {
         return Err(Error::MassNotPositiveDefinite {
             reason: "Cholesky factorisation failed (a zero or negative mass or inertia?)".into(),
         });

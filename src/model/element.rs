@@ -1,7 +1,6 @@
 //! A force element: a [`ForceLaw`] on the local coordinate `u = w·q`.
 
 use crate::force::{ForceLaw, LinearPart};
-use nalgebra::DMatrix;
 
 /// A force element: law `f(θ, u, u̇)` on `u = w·q`, acting back as `-w f`.
 ///
@@ -59,7 +58,7 @@ impl Element {
     }
 
     /// `a += s w wᵀ`.
-    pub(crate) fn add_outer(&self, a: &mut DMatrix<f64>, s: f64) {
+    pub(crate) fn add_outer(&self, a: &mut nalgebra::DMatrix<f64>, s: f64) {
         for &(i, wi) in &self.weights {
             for &(j, wj) in &self.weights {
                 a[(i, j)] += s * wi * wj;

@@ -10,20 +10,39 @@
 mod builder;
 mod element;
 mod load;
+mod sparse;
 
 pub use builder::ModelBuilder;
 pub use element::Element;
 pub use load::Load;
+pub use sparse::SparseMatrix;
 
+use crate::error::{Error, Result};
 use nalgebra::DMatrix;
 
-/// A validated model: DOF names, constant matrices, loads and force elements.
+/// The constant matrices as dense copies, for the parts of hbal that work densely (the full
+/// formulation, the time integration, the monodromy matrix).
+#[derive(Debug, Clone)]
+pub struct DenseMatrices {
+    /// M.
+    pub mass: DMatrix<f64>,
+    /// D (structural, without elements).
+    pub damping: DMatrix<f64>,
+    /// K (structural, without elements).
+    pub stiffness: DMatrix<f64>,
+    /// `D0 = D + Σ d0_e w_e w_eᵀ`.
+    pub d0: DMatrix<f64>,
+    /// `K0 = K + Σ k0_e w_e w_eᵀ`.
+    pub k0: DMatrix<f64>,
+}
+
+/// A validated model: DOF names, constant matrices (sparse), loads and force elements.
 #[derive(Debug)]
 pub struct Model {
     pub(crate) dofs: Vec<String>,
-    pub(crate) mass: DMatrix<f64>,
-    pub(crate) damping: DMatrix<f64>,
-    pub(crate) stiffness: DMatrix<f64>,
+    pub(crate) mass: SparseMatrix,
+    pub(crate) damping: SparseMatrix,
+    pub(crate) stiffness: SparseMatrix,
     pub(crate) loads: Vec<Load>,
     pub(crate) elements: Vec<Element>,
 }
@@ -39,7 +58,7 @@ impl Model {
     ///     .load("x", 1, 1.0, 0.0)
     ///     .build()
     ///     .unwrap();
-    /// assert_eq!(model.k0()[(0, 0)], 8.0);
+    /// assert_eq!(model.k0().get(0, 0), 8.0);
     /// // Bad input is an error that names the place:
     /// let err = Model::builder(&["x"]).mass_diagonal(&[1.0]).load("y", 1, 1.0, 0.0).build();
     /// assert!(err.unwrap_err().to_string().contains("unknown DOF `y`"));
@@ -64,18 +83,46 @@ impl Model {
     }
 
     /// Mass matrix M.
-    pub fn mass(&self) -> &DMatrix<f64> {
+    pub fn mass(&self) -> &SparseMatrix {
         &self.mass
     }
 
     /// Structural damping D (without elements).
-    pub fn structural_damping(&self) -> &DMatrix<f64> {
+    pub fn structural_damping(&self) -> &SparseMatrix {
         &self.damping
     }
 
     /// Structural stiffness K (without elements).
-    pub fn structural_stiffness(&self) -> &DMatrix<f64> {
+    pub fn structural_stiffness(&self) -> &SparseMatrix {
         &self.stiffness
+    }
+
+    /// Largest model (in DOFs) whose matrices are copied densely: `n²` entries each.
+    pub const MAX_DENSE_DOFS: usize = 4096;
+
+    /// Dense copies of M, D, K, D0, K0 for `context`, which works densely; an error for a
+    /// model above [`Model::MAX_DENSE_DOFS`] DOFs.
+    pub fn dense(&self, context: &str) -> Result<DenseMatrices> {
+        let n = self.n_dofs();
+        if n > Self::MAX_DENSE_DOFS {
+            return Err(Error::invalid(
+                context,
+                "DOFs",
+                n as f64,
+                format!(
+                    "<= {} for dense matrices ({:.1} GiB each here): use the condensed formulation (`--formulation condensed`)",
+                    Self::MAX_DENSE_DOFS,
+                    (n * n * 8) as f64 / (1u64 << 30) as f64
+                ),
+            ));
+        }
+        Ok(DenseMatrices {
+            mass: self.mass.to_dense(),
+            damping: self.damping.to_dense(),
+            stiffness: self.stiffness.to_dense(),
+            d0: self.d0().to_dense(),
+            k0: self.k0().to_dense(),
+        })
     }
 
     /// Loads.
@@ -89,21 +136,21 @@ impl Model {
     }
 
     /// `K0 = K + Σ_e k0_e w_e w_eᵀ`, the constant stiffness of the paper's split.
-    pub fn k0(&self) -> DMatrix<f64> {
-        let mut k0 = self.stiffness.clone();
-        for e in &self.elements {
-            e.add_outer(&mut k0, e.linear.stiffness);
-        }
-        k0
+    pub fn k0(&self) -> SparseMatrix {
+        self.stiffness.plus_outer(
+            self.elements
+                .iter()
+                .map(|e| (e.linear.stiffness, e.weights.as_slice())),
+        )
     }
 
     /// `D0 = D + Σ_e d0_e w_e w_eᵀ`, the constant damping of the paper's split.
-    pub fn d0(&self) -> DMatrix<f64> {
-        let mut d0 = self.damping.clone();
-        for e in &self.elements {
-            e.add_outer(&mut d0, e.linear.damping);
-        }
-        d0
+    pub fn d0(&self) -> SparseMatrix {
+        self.damping.plus_outer(
+            self.elements
+                .iter()
+                .map(|e| (e.linear.damping, e.weights.as_slice())),
+        )
     }
 
     /// Highest harmonic order of any load (0 for a static load only).

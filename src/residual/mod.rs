@@ -42,8 +42,8 @@ pub struct HarmonicBalance<'m> {
     f_ext: Vec<Complex64>,
     /// `F_ext - Σ w f0`: the load seen by the split (offsets of the linear parts moved over).
     f_split: Vec<Complex64>,
-    d0: DMatrix<f64>,
-    k0: DMatrix<f64>,
+    /// Dense M, D0, K0 of the full formulation (none when condensed).
+    dense: Option<Box<crate::model::DenseMatrices>>,
     active: Vec<ActiveElement>,
     thetas: Vec<f64>,
     /// Unknowns per harmonic: n DOFs, or m element coordinates when condensed.
@@ -164,7 +164,6 @@ impl<'m> HarmonicBalance<'m> {
                 &mut f_split[..n],
             );
         }
-        let (d0, k0) = (model.d0(), model.k0());
         let samples = basis.samples();
         // The laws see the shaft angle Ωt = ν θ_j.
         let thetas: Vec<f64> = (0..samples).map(|j| basis.shaft_angle(j)).collect();
@@ -213,8 +212,7 @@ impl<'m> HarmonicBalance<'m> {
             z: DynamicStiffness::empty(),
             f_ext,
             f_split,
-            d0,
-            k0,
+            dense: None,
             active,
             thetas,
             n,
@@ -223,7 +221,9 @@ impl<'m> HarmonicBalance<'m> {
         };
         match formulation {
             Formulation::Full => {
-                hb.z = DynamicStiffness::new(&basis, model.mass(), &hb.d0, &hb.k0)?;
+                let dense = model.dense("full formulation")?;
+                hb.z = DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?;
+                hb.dense = Some(Box::new(dense));
             }
             Formulation::Condensed => hb.condense()?,
         }
@@ -434,14 +434,19 @@ impl<'m> HarmonicBalance<'m> {
                 reason: "the Ω-derivative of the condensed formulation is not available yet: continue with the full formulation".into(),
             });
         }
-        let m = self.model.mass();
+        let Some(dense) = self.dense.as_deref() else {
+            return Err(Error::Solver {
+                reason: "no dense matrices for the Ω-derivative".into(),
+            });
+        };
+        let m = &dense.mass;
         for k in 0..=h {
             let kf = k as f64 / nu;
             for i in 0..n {
                 let mut acc = Complex64::default();
                 for j in 0..n {
                     let dz =
-                        Complex64::new(-2.0 * kf * kf * omega * m[(i, j)], kf * self.d0[(i, j)]);
+                        Complex64::new(-2.0 * kf * kf * omega * m[(i, j)], kf * dense.d0[(i, j)]);
                     acc += dz * ws.q[k * n + j];
                 }
                 ws.rhs[k * n + i] = acc;
@@ -491,7 +496,12 @@ impl<'m> HarmonicBalance<'m> {
             self.basis = basis;
             return self.condense();
         }
-        self.z = DynamicStiffness::new(&basis, self.model.mass(), &self.d0, &self.k0)?;
+        let Some(dense) = self.dense.as_deref() else {
+            return Err(Error::Solver {
+                reason: "no dense matrices for the full formulation".into(),
+            });
+        };
+        self.z = DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?;
         self.basis = basis;
         Ok(())
     }

@@ -156,9 +156,10 @@ pub const MAX_COARSE_UNKNOWNS: usize = 640;
 /// The highest undamped natural frequency `ω_max` (rad/s) of `(M, K0)`: `√λ_max` of
 /// `L⁻¹ K0 L⁻ᵀ` with `M = L Lᵀ`; `None` if `M` is not positive definite.
 pub fn highest_natural_frequency(model: &Model) -> Option<f64> {
-    let chol = model.mass().clone().cholesky()?;
+    let dense = model.dense("natural frequencies").ok()?;
+    let chol = dense.mass.cholesky()?;
     let l = chol.l();
-    let k0 = model.k0();
+    let k0 = dense.k0;
     let a = l.solve_lower_triangular(&k0)?;
     let b = l.solve_lower_triangular(&a.transpose())?;
     let sym = (&b + b.transpose()) * 0.5;

@@ -94,7 +94,7 @@ impl<'m> Flow<'m> {
         let n = model.n_dofs();
         let m_inv = model
             .mass()
-            .clone()
+            .to_dense()
             .cholesky()
             .ok_or_else(|| Error::MassNotPositiveDefinite {
                 reason: "Cholesky factorisation failed".into(),
@@ -131,8 +131,10 @@ impl<'m> Flow<'m> {
             scale_q,
             omega_s: scale_v / scale_q,
             atol,
-            mk0: row_major(&(&m_inv * model.structural_stiffness() / (scale_v / scale_q))),
-            md0: row_major(&(&m_inv * model.structural_damping())),
+            mk0: row_major(
+                &(&m_inv * model.structural_stiffness().to_dense() / (scale_v / scale_q)),
+            ),
+            md0: row_major(&(&m_inv * model.structural_damping().to_dense())),
             mw: model
                 .elements()
                 .iter()

@@ -189,6 +189,8 @@ impl FloquetOptions {
                 got: format!("{} DOFs", solution.dof_names().len()),
             });
         }
+        // The monodromy matrix is dense (2n × 2n): refuse what would not fit.
+        model.dense("stability (Floquet multipliers)")?;
         let omega = solution.basis().omega();
         let (scale_q, omega_max) = scales(model, solution);
         let scale_v = scale_q * omega_max;
@@ -312,8 +314,8 @@ fn scales(model: &Model, solution: &Solution) -> (f64, f64) {
         scale_q = 1.0;
     }
     // Largest and smallest element stiffness and damping along the orbit, from the samples.
-    let mut k_max = model.structural_stiffness().clone();
-    let mut d_max = model.structural_damping().clone();
+    let mut k_max = model.structural_stiffness().to_dense();
+    let mut d_max = model.structural_damping().to_dense();
     let (mut q, mut v) = (vec![0.0; n], vec![0.0; n]);
     for e in model.elements() {
         let (mut km, mut dm) = (0.0_f64, 0.0_f64);
@@ -335,7 +337,7 @@ fn scales(model: &Model, solution: &Solution) -> (f64, f64) {
         e.add_outer(&mut d_max, dm.max(mean.damping.abs()));
     }
     let mut omega_max = omega;
-    if let Some(chol) = model.mass().clone().cholesky() {
+    if let Some(chol) = model.mass().to_dense().cholesky() {
         if let Some(l_inv) = chol.l().try_inverse() {
             let largest = |a: &DMatrix<f64>| {
                 let s = &l_inv * a * l_inv.transpose();

@@ -21,8 +21,8 @@ pub(crate) fn rigid_body_modes(model: &Model) -> DMatrix<f64> {
             g += rows.transpose() * rows / (norm * norm);
         }
     };
-    add_rows(model.structural_stiffness());
-    add_rows(model.structural_damping());
+    add_rows(&model.structural_stiffness().to_dense());
+    add_rows(&model.structural_damping().to_dense());
     for e in model.elements() {
         let mut w = DMatrix::<f64>::zeros(1, n);
         for &(i, wi) in e.weights() {

@@ -358,7 +358,10 @@ pub(crate) fn segment_bounds(model: &Model) -> Vec<f64> {
 /// its natural frequencies. 1 where that is zero or singular.
 fn state_scale(model: &Model, omega: f64) -> Vec<f64> {
     let n = model.n_dofs();
-    let (m, d0, k0) = (model.mass(), model.d0(), model.k0());
+    let Ok(dense) = model.dense("time integration") else {
+        return vec![1.0; 2 * n];
+    };
+    let (m, d0, k0) = (&dense.mass, &dense.d0, &dense.k0);
     let mut q = vec![0.0; n];
     let mut w_max: f64 = 0.0;
     let orders: std::collections::BTreeSet<usize> = model.loads().iter().map(|l| l.order).collect();

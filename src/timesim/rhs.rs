@@ -17,14 +17,13 @@ pub(super) struct Rhs<'m> {
 
 impl<'m> Rhs<'m> {
     pub(super) fn new(model: &'m Model, omega: f64) -> Result<Self> {
-        let chol =
-            model
-                .mass()
-                .clone()
-                .cholesky()
-                .ok_or_else(|| Error::MassNotPositiveDefinite {
-                    reason: "Cholesky factorisation failed".into(),
-                })?;
+        let chol = model
+            .dense("time integration")?
+            .mass
+            .cholesky()
+            .ok_or_else(|| Error::MassNotPositiveDefinite {
+                reason: "Cholesky factorisation failed".into(),
+            })?;
         Ok(Self {
             model,
             chol,
@@ -52,17 +51,9 @@ impl ODE<f64, Vec<f64>> for Rhs<'_> {
         let mut a = self.acc.borrow_mut();
         a.fill(0.0);
         self.model.load_into(theta, a.as_mut_slice());
-        let (d, k) = (
-            self.model.structural_damping(),
-            self.model.structural_stiffness(),
-        );
-        for i in 0..n {
-            let mut s = 0.0;
-            for j in 0..n {
-                s += d[(i, j)] * v[j] + k[(i, j)] * q[j];
-            }
-            a[i] -= s;
-        }
+        let a_slice = a.as_mut_slice();
+        self.model.structural_damping().mul_add(-1.0, v, a_slice);
+        self.model.structural_stiffness().mul_add(-1.0, q, a_slice);
         for e in self.model.elements() {
             let f = e.law().force(theta, e.gather(q), e.gather(v));
             e.scatter_add(-f, a.as_mut_slice());
