@@ -132,7 +132,10 @@ impl std::fmt::Debug for SparseDynamicStiffness {
 }
 
 /// Relative residual of a test solve above which `Z_k` counts as singular.
-const SINGULAR_RESIDUAL: f64 = 1e-6;
+/// (normwise backward error `‖Z x - b‖ / (‖Z‖_F ‖x‖ + ‖b‖)`; a stable LU of a regular
+/// matrix gives about 1e-16 whatever its condition, a singular one gives a non-finite or large
+/// one).
+const SINGULAR_RESIDUAL: f64 = 1e-8;
 
 impl SparseDynamicStiffness {
     /// Analyses the pattern once and factors `Z_k` for every harmonic of `basis`; an error
@@ -196,8 +199,9 @@ impl SparseDynamicStiffness {
                 .map(|(a, b)| (a - b).norm_sqr())
                 .sum::<f64>()
                 .sqrt();
-            let norm: f64 = test.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
-            let rel = err / norm;
+            let norm = |v: &[Complex64]| v.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
+            let z_norm = z.val().iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
+            let rel = err / (z_norm * norm(&x) + norm(&test));
             if !(rel.is_finite() && rel < SINGULAR_RESIDUAL) {
                 return Err(singular(if rel.is_finite() { 1.0 / rel } else { 0.0 }));
             }

@@ -148,13 +148,14 @@ impl ModelBuilder {
                 reason: "the model has no DOFs".into(),
             });
         }
+        let mut by_name = std::collections::HashMap::with_capacity(n);
         for (i, d) in self.dofs.iter().enumerate() {
             if d.trim().is_empty() {
                 return Err(Error::InvalidDofs {
                     reason: format!("DOF {i} has an empty name"),
                 });
             }
-            if self.dofs[..i].contains(d) {
+            if by_name.insert(d.as_str(), i).is_some() {
                 return Err(Error::InvalidDofs {
                     reason: format!("DOF name `{d}` appears twice"),
                 });
@@ -167,16 +168,18 @@ impl ModelBuilder {
                 got: format!("({i}, {j})"),
             });
         }
-        let known = self.dofs.join(", ");
+        // The known names for an unknown-DOF message (the first 20 of a large model).
+        let known = if n <= 20 {
+            self.dofs.join(", ")
+        } else {
+            format!("{}, ... ({n} DOFs)", self.dofs[..20].join(", "))
+        };
         let index = |context: &str, name: &str| -> Result<usize> {
-            self.dofs
-                .iter()
-                .position(|d| d == name)
-                .ok_or_else(|| Error::UnknownDof {
-                    context: context.to_string(),
-                    name: name.to_string(),
-                    known: known.clone(),
-                })
+            by_name.get(name).copied().ok_or_else(|| Error::UnknownDof {
+                context: context.to_string(),
+                name: name.to_string(),
+                known: known.clone(),
+            })
         };
 
         let mass = match self.mass.clone() {
