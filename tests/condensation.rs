@@ -151,3 +151,88 @@ fn condensing_a_linear_model_is_an_error() {
         "{err}"
     );
 }
+
+/// `∂R/∂Ω` of the condensed residual (the receptances' Ω-derivative from the same sparse
+/// factors) against central differences of the residual.
+#[test]
+fn condensed_omega_derivative_matches_finite_differences() {
+    let model = chain();
+    let omega = 300.0;
+    let basis = HarmonicBasis::new(omega, 12).unwrap();
+    let full = solve(&model, basis, Formulation::Full);
+    let mut hb = HarmonicBalance::with_formulation(&model, basis, Formulation::Condensed).unwrap();
+    let mut ws = hb.workspace();
+    let layout = hb.layout();
+    // A point off the solution: the coordinates of the full solution, perturbed.
+    let mut u = hb.unknowns_of(full.harmonics()).unwrap();
+    for (i, v) in u.iter_mut().enumerate() {
+        *v *= 1.0 + 0.1 * ((i % 5) as f64 - 2.0);
+    }
+    let mut x = vec![0.0; layout.len()];
+    layout.pack(&u, &mut x);
+    let mut analytic = vec![0.0; layout.len()];
+    hb.omega_derivative_real_into(&x, &mut analytic, &mut ws)
+        .unwrap();
+    let step = 1e-5 * omega;
+    let mut r = |o: f64| {
+        hb.set_omega(o).unwrap();
+        let mut out = vec![0.0; layout.len()];
+        hb.residual_real_into(&x, &mut out, None, &mut ws).unwrap();
+        out
+    };
+    let (rp, rm) = (r(omega + step), r(omega - step));
+    let fd: Vec<f64> = rp
+        .iter()
+        .zip(&rm)
+        .map(|(a, b)| (a - b) / (2.0 * step))
+        .collect();
+    let scale = fd.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let err = analytic
+        .iter()
+        .zip(&fd)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        scale > 0.0 && err < 1e-6 * scale,
+        "error {err:.2e} of {scale:.2e}"
+    );
+}
+
+/// A sweep of the chain with stability in the condensed formulation: every point is the
+/// full formulation's solution at its Ω (to 1e-8), both branches end at the same orbit with
+/// the same multipliers. (The steps differ: the step length is measured in the unknowns.)
+#[test]
+fn condensed_continuation_equals_full() {
+    let model = chain();
+    let basis = HarmonicBasis::new(250.0, 12).unwrap();
+    let run = |formulation| {
+        hbal::continuation::Continuation {
+            formulation,
+            max_points: 60,
+            ..Default::default()
+        }
+        .run(&model, basis, 300.0, |_| {})
+        .unwrap()
+    };
+    let (full, cond) = (run(Formulation::Full), run(Formulation::Condensed));
+    assert!(full.stop.is_normal_end() && cond.stop.is_normal_end());
+    assert!(cond.points.len() > 5, "{} points", cond.points.len());
+    for p in &cond.points {
+        let hb = HarmonicBalance::new(&model, basis.with_omega(p.omega).unwrap()).unwrap();
+        let sol = Newton::new()
+            .with_tolerance(1e-13)
+            .unwrap()
+            .solve_from(&hb, &p.harmonics, &mut hb.workspace())
+            .unwrap();
+        let d = relative_error(&p.harmonics, sol.harmonics(), 7, 12);
+        assert!(
+            d < 1e-8,
+            "condensed point at Ω = {}: {d:.1e} from the full solution",
+            p.omega
+        );
+    }
+    let (a, b) = (full.points.last().unwrap(), cond.points.last().unwrap());
+    assert!((a.omega - b.omega).abs() < 1e-9 * a.omega);
+    assert!(relative_error(&b.harmonics, &a.harmonics, 7, 12) < 1e-8);
+    let (fa, fb) = (a.floquet.as_ref().unwrap(), b.floquet.as_ref().unwrap());
+    assert!((fa.max_abs() - fb.max_abs()).abs() < 1e-6, "multipliers");
+}

@@ -60,10 +60,10 @@ impl Continuation {
     ) -> Result<Branch> {
         crate::error::check_positive("continuation", "to", to)?;
         let from = basis.omega();
-        let mut hb = HarmonicBalance::new(model, basis)?;
+        let mut hb = HarmonicBalance::with_formulation(model, basis, self.formulation)?;
         crate::solve::check_dense_for_continuation(&hb)?;
         if let Some(q) = initial {
-            if q.len() != hb.len() {
+            if hb.unknowns_of(q).is_none() {
                 return Err(Error::DimensionMismatch {
                     context: "continuation start".into(),
                     expected: format!(
@@ -92,7 +92,13 @@ impl Continuation {
         let layout = hb.layout();
         let m = layout.len();
         let mut x = vec![0.0; m];
-        layout.pack(start.harmonics(), &mut x);
+        // The solution carries all DOFs; the unknowns may be the element coordinates.
+        let unknowns = hb
+            .unknowns_of(start.harmonics())
+            .ok_or_else(|| Error::Solver {
+                reason: "continuation start: the solution does not match the discretisation".into(),
+            })?;
+        layout.pack(&unknowns, &mut x);
         let mut tr = Tracer::new(hb, Scales::new(0.0, from, 1.0));
         tr.sc = Scales::new(tr.rms(&x), from, tr.load_norm());
         let direction = if to >= from { 1.0 } else { -1.0 };
@@ -272,8 +278,14 @@ impl Continuation {
         omega: f64,
         residual: f64,
     ) -> Option<String> {
-        let mut harmonics = vec![Complex64::default(); hb.len()];
-        hb.layout().unpack(x, &mut harmonics);
+        let mut unknowns = vec![Complex64::default(); hb.len()];
+        hb.layout().unpack(x, &mut unknowns);
+        // All DOFs (the condensed formulation recovers them from the coordinates; `hb` sits
+        // at `omega` after the corrector).
+        let harmonics = match hb.full_harmonics(&unknowns, &mut hb.workspace().eval) {
+            Ok(h) => h,
+            Err(e) => return Some(e.to_string()),
+        };
         let basis = match hb.basis().with_omega(omega) {
             Ok(b) => b,
             Err(e) => return Some(e.to_string()),

@@ -273,6 +273,9 @@ pub struct Continuation {
     /// solve there from the point: about the cost of the point's own corrector times 8 with
     /// the dense Jacobian). Default `false`.
     pub error_estimate: bool,
+    /// The formulation of the harmonic balance along the branch (the condensed one solves
+    /// for the element coordinates; points still carry all DOFs). Default full.
+    pub formulation: crate::Formulation,
 }
 
 impl Default for Continuation {
@@ -287,6 +290,7 @@ impl Default for Continuation {
             max_corrector: 8,
             stability: Some(FloquetOptions::default()),
             error_estimate: false,
+            formulation: crate::Formulation::Full,
         }
     }
 }

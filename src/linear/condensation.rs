@@ -155,6 +155,57 @@ impl Condensation {
         q
     }
 
+    /// The linear part of `∂R/∂Ω` of the condensed residual `R_k = G_k⁻¹ (U_k - U_lin,k) +
+    /// R_k(U)` (`U_lin,k = Wᵀ Z_k⁻¹ F_k`), per harmonic into `out` (`(H+1) m`):
+    ///
+    /// `∂/∂Ω [G_k⁻¹ (U_k - U_lin,k)] = G_k⁻¹ Wᵀ Z_k⁻¹ (dZ_k/dΩ) y_k`,
+    /// `y_k = Z_k⁻¹ (F_k + W G_k⁻¹ (U_k - U_lin,k))`,
+    ///
+    /// from `dG/dΩ = -Wᵀ Z⁻¹ (dZ/dΩ) Z⁻¹ W` and `dZ⁻¹/dΩ = -Z⁻¹ (dZ/dΩ) Z⁻¹` (at a solution
+    /// `y_k` is the full `Q_k`). Two sparse solves per harmonic. `g_inv` holds the `G_k⁻¹`,
+    /// `load` the condensed load `G_k⁻¹ U_lin,k`, `f` the full load.
+    #[allow(clippy::too_many_arguments)]
+    pub fn omega_derivative(
+        &self,
+        g_inv: &crate::harmonic::DynamicStiffness,
+        load: &[Complex64],
+        f: &[Complex64],
+        u: &[Complex64],
+        nu: usize,
+        omega: f64,
+        out: &mut [Complex64],
+    ) {
+        let (n, m) = (self.z.n(), self.len());
+        let h = self.z.harmonics();
+        let mut y = vec![Complex64::default(); n];
+        let mut t = vec![Complex64::default(); n];
+        let mut a = vec![Complex64::default(); m];
+        for k in 0..=h {
+            let gi = g_inv.matrix(k);
+            // a = G⁻¹ (U - U_lin) = G⁻¹ U - load.
+            for r in 0..m {
+                a[r] =
+                    (0..m).map(|c| gi[(r, c)] * u[k * m + c]).sum::<Complex64>() - load[k * m + r];
+            }
+            y.copy_from_slice(&f[k * n..(k + 1) * n]);
+            for (c, w) in self.coordinates.iter().enumerate() {
+                for &(i, wi) in w {
+                    y[i] += a[c] * wi;
+                }
+            }
+            self.z.solve_in_place(k, &mut y, 1);
+            self.z
+                .apply_omega_derivative(k as f64 / nu as f64, omega, &y, &mut t);
+            self.z.solve_in_place(k, &mut t, 1);
+            for r in 0..m {
+                a[r] = self.gather(r, &t);
+            }
+            for r in 0..m {
+                out[k * m + r] = (0..m).map(|c| gi[(r, c)] * a[c]).sum();
+            }
+        }
+    }
+
     /// `U = Wᵀ Q` per harmonic.
     pub fn project(&self, q: &[Complex64]) -> Vec<Complex64> {
         let (n, m) = (self.z.n(), self.len());

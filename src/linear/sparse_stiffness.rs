@@ -102,6 +102,24 @@ impl SparsePattern {
         }
     }
 
+    /// `out ← (dZ/dΩ) x` for `Z = -(κΩ)² M + i κΩ D0 + K0`: `(-2κ²Ω M + i κ D0) x`.
+    fn apply_omega_derivative(
+        &self,
+        kappa: f64,
+        omega: f64,
+        x: &[Complex64],
+        out: &mut [Complex64],
+    ) {
+        out.fill(Complex64::default());
+        for (j, xj) in x.iter().enumerate() {
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let dz =
+                    Complex64::new(-2.0 * kappa * kappa * omega * self.m[p], kappa * self.d[p]);
+                out[self.row_idx[p]] += dz * xj;
+            }
+        }
+    }
+
     fn symbolic(&self) -> SymbolicSparseColMat<usize> {
         SymbolicSparseColMat::new_checked(
             self.n,
@@ -225,6 +243,18 @@ impl SparseDynamicStiffness {
     pub fn solve_in_place(&self, k: usize, x: &mut [Complex64], columns: usize) {
         let n = self.pattern.n;
         self.factors[k].solve_in_place(MatMut::from_column_major_slice_mut(x, n, columns));
+    }
+
+    /// `out ← (dZ_k/dΩ) x`, where harmonic k oscillates at `k Ω / ν` (`kappa = k/ν`) and
+    /// `omega` is Ω.
+    pub fn apply_omega_derivative(
+        &self,
+        kappa: f64,
+        omega: f64,
+        x: &[Complex64],
+        out: &mut [Complex64],
+    ) {
+        self.pattern.apply_omega_derivative(kappa, omega, x, out);
     }
 
     /// `out ← Z_k x`.

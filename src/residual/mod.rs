@@ -427,30 +427,20 @@ impl<'m> HarmonicBalance<'m> {
         let layout = self.layout();
         let (n, h) = (layout.n, layout.h);
         let omega = self.basis.omega();
-        let nu = self.basis.subharmonic() as f64;
         layout.unpack(x, &mut ws.q);
-        if self.condensed.is_some() {
-            return Err(Error::Solver {
-                reason: "the Ω-derivative of the condensed formulation is not available yet: continue with the full formulation".into(),
-            });
-        }
-        let Some(dense) = self.dense.as_deref() else {
-            return Err(Error::Solver {
-                reason: "no dense matrices for the Ω-derivative".into(),
-            });
-        };
-        let m = &dense.mass;
-        for k in 0..=h {
-            let kf = k as f64 / nu;
-            for i in 0..n {
-                let mut acc = Complex64::default();
-                for j in 0..n {
-                    let dz =
-                        Complex64::new(-2.0 * kf * kf * omega * m[(i, j)], kf * dense.d0[(i, j)]);
-                    acc += dz * ws.q[k * n + j];
-                }
-                ws.rhs[k * n + i] = acc;
-            }
+        if let Some(b) = self.condensed.as_deref() {
+            let (cond, f_full) = (&b.0, &b.1);
+            cond.omega_derivative(
+                &self.z,
+                &self.f_split,
+                f_full,
+                &ws.q,
+                self.basis.subharmonic(),
+                omega,
+                &mut ws.rhs,
+            );
+        } else {
+            self.dense_omega_derivative(&mut ws.rhs, &ws.q)?;
         }
         let b = &mut ws.eval;
         for act in &self.active {
@@ -473,6 +463,32 @@ impl<'m> HarmonicBalance<'m> {
             }
         }
         layout.pack(&ws.rhs, out);
+        Ok(())
+    }
+
+    /// `rhs ← (dZ_k/dΩ) Q_k` with the dense M, D0 of the full formulation.
+    fn dense_omega_derivative(&self, rhs: &mut [Complex64], q: &[Complex64]) -> Result<()> {
+        let Some(dense) = self.dense.as_deref() else {
+            return Err(Error::Solver {
+                reason: "no dense matrices for the Ω-derivative".into(),
+            });
+        };
+        let (n, h) = (self.n, self.basis.harmonics());
+        let omega = self.basis.omega();
+        let nu = self.basis.subharmonic() as f64;
+        let m = &dense.mass;
+        for k in 0..=h {
+            let kf = k as f64 / nu;
+            for i in 0..n {
+                let mut acc = Complex64::default();
+                for j in 0..n {
+                    let dz =
+                        Complex64::new(-2.0 * kf * kf * omega * m[(i, j)], kf * dense.d0[(i, j)]);
+                    acc += dz * q[k * n + j];
+                }
+                rhs[k * n + i] = acc;
+            }
+        }
         Ok(())
     }
 
