@@ -197,8 +197,8 @@ impl Condensation {
             self.z
                 .apply_omega_derivative(k as f64 / nu as f64, omega, &y, &mut t);
             self.z.solve_in_place(k, &mut t, 1);
-            for r in 0..m {
-                a[r] = self.gather(r, &t);
+            for (r, ar) in a.iter_mut().enumerate() {
+                *ar = self.gather(r, &t);
             }
             for r in 0..m {
                 out[k * m + r] = (0..m).map(|c| gi[(r, c)] * a[c]).sum();
