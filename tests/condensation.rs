@@ -3,6 +3,8 @@
 //! gear meshes (mesh stiffness and backlash on one coordinate each), for Newton and for the
 //! two-level Anderson map.
 
+mod common;
+
 use hbal::compare::relative_error;
 use hbal::force::{Backlash, MeshDamping, MeshProfile, MeshStiffness};
 use hbal::nalgebra::DMatrix;
@@ -235,4 +237,37 @@ fn condensed_continuation_equals_full() {
     assert!(relative_error(&b.harmonics, &a.harmonics, 7, 12) < 1e-8);
     let (fa, fb) = (a.floquet.as_ref().unwrap(), b.floquet.as_ref().unwrap());
     assert!((fa.max_abs() - fb.max_abs()).abs() < 1e-6, "multipliers");
+}
+
+/// `hbal solve --formulation condensed|full`: the same max |q| per DOF; a bad value exits 2.
+#[test]
+fn cli_formulation_switch() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/scenes/chain_backlash.toml"
+    );
+    let max_abs = |f: &str| -> Vec<f64> {
+        let out = common::hbal(&["solve", scene, "--formulation", f, "--json"]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        json["dofs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|d| d["max_abs"].as_f64().unwrap())
+            .collect()
+    };
+    let (full, cond) = (max_abs("full"), max_abs("condensed"));
+    assert_eq!(full.len(), 3);
+    for (a, b) in full.iter().zip(&cond) {
+        assert!((a - b).abs() < 1e-9 * a.abs(), "{a} vs {b}");
+    }
+    let bad = common::hbal(&["solve", scene, "--formulation", "sparse"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected `full`, `condensed` or `auto`"));
 }

@@ -8,7 +8,8 @@ use std::path::Path;
 
 pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
     let scene = load(path, &super::SolverArgs::default())?;
-    HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
+    HarmonicBalance::with_formulation(&scene.model, scene.basis, hbal::Formulation::Auto)
+        .with_context(|| scene.file.clone())?;
     say!(
         "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s, H = {}, N = {}, solver {})",
         scene.file,

@@ -23,7 +23,8 @@ pub(crate) fn compare(
         Some(_) => vec![scene.method.name()],
         None => hbal::scene::METHODS.to_vec(),
     };
-    let hb = HarmonicBalance::new(&scene.model, scene.basis).with_context(|| scene.file.clone())?;
+    let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
+        .with_context(|| scene.file.clone())?;
     let h = scene.basis.harmonics();
     let n = scene.model.n_dofs();
     let mut solutions = Vec::new();

@@ -72,6 +72,10 @@ pub(crate) struct SolverArgs {
     /// Relative residual tolerance of the solver, in [0, 1) (default: the scene's).
     #[arg(long)]
     pub(crate) tolerance: Option<f64>,
+    /// Unknowns: `full` (all DOFs per harmonic), `condensed` (the element coordinates,
+    /// exact; for large models), or `auto` (condensed where it pays).
+    #[arg(long, default_value = "auto")]
+    pub(crate) formulation: hbal::Formulation,
 }
 
 /// `--harmonics`: a number, or `auto`.
@@ -122,8 +126,16 @@ pub(crate) fn load(path: &Path, args: &SolverArgs) -> Result<Scene, Failure> {
     }
     scene.method = args.with_tolerance(scene.method, &scene.file)?;
     scene.basis = basis_with(&scene.basis, args, &scene.file)?;
+    if let Some(auto) = scene.auto.as_mut() {
+        auto.formulation = args.formulation;
+    }
     match args.harmonics {
-        Some(HarmonicsArg::Auto) => scene.auto = Some(scene.auto.unwrap_or_default()),
+        Some(HarmonicsArg::Auto) => {
+            scene.auto = Some(hbal::solve::AutoHarmonics {
+                formulation: args.formulation,
+                ..scene.auto.unwrap_or_default()
+            })
+        }
         Some(HarmonicsArg::Count(_)) => scene.auto = None,
         None => {}
     }

@@ -71,7 +71,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             )
         }
         None => {
-            let hb = HarmonicBalance::new(&scene.model, scene.basis)
+            let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
                 .with_context(|| scene.file.clone())?;
             let mut ws = hb.workspace();
             let sol =

@@ -175,6 +175,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             None
         },
         error_estimate: opts.error_estimate,
+        formulation: args.formulation,
         ..defaults
     };
     let started = Instant::now();

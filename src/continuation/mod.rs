@@ -274,7 +274,8 @@ pub struct Continuation {
     /// the dense Jacobian). Default `false`.
     pub error_estimate: bool,
     /// The formulation of the harmonic balance along the branch (the condensed one solves
-    /// for the element coordinates; points still carry all DOFs). Default full.
+    /// for the element coordinates; points still carry all DOFs). Default
+    /// [`Formulation::Auto`](crate::Formulation::Auto).
     pub formulation: crate::Formulation,
 }
 
@@ -290,7 +291,7 @@ impl Default for Continuation {
             max_corrector: 8,
             stability: Some(FloquetOptions::default()),
             error_estimate: false,
-            formulation: crate::Formulation::Full,
+            formulation: crate::Formulation::Auto,
         }
     }
 }

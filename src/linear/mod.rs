@@ -17,4 +17,49 @@ pub enum Formulation {
     Full,
     /// The m element coordinates per harmonic, exact (sparse `Z_k`, receptances).
     Condensed,
+    /// Condensed where it pays: above [`Model::MAX_DENSE_DOFS`](crate::Model::MAX_DENSE_DOFS)
+    /// DOFs, or from 16 DOFs when there are at most a quarter as many time-varying or
+    /// nonlinear elements; full otherwise.
+    Auto,
+}
+
+impl Formulation {
+    /// The formulation `self` means for `model` (`Auto` resolved).
+    ///
+    /// ```
+    /// use hbal::{catalog::GearBacklash, Formulation};
+    /// let model = GearBacklash::default().model()?;
+    /// assert_eq!(Formulation::Auto.resolve(&model), Formulation::Full);
+    /// # Ok::<(), hbal::Error>(())
+    /// ```
+    pub fn resolve(self, model: &crate::Model) -> Formulation {
+        match self {
+            Formulation::Auto => {
+                let n = model.n_dofs();
+                let m = model
+                    .elements()
+                    .iter()
+                    .filter(|e| !e.law().is_linear_time_invariant())
+                    .count();
+                if n > crate::Model::MAX_DENSE_DOFS || (n >= 16 && m >= 1 && 4 * m <= n) {
+                    Formulation::Condensed
+                } else {
+                    Formulation::Full
+                }
+            }
+            f => f,
+        }
+    }
+}
+
+impl std::str::FromStr for Formulation {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "full" => Ok(Formulation::Full),
+            "condensed" => Ok(Formulation::Condensed),
+            "auto" => Ok(Formulation::Auto),
+            _ => Err(format!("expected `full`, `condensed` or `auto`, got `{s}`")),
+        }
+    }
 }

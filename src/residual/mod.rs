@@ -219,8 +219,8 @@ impl<'m> HarmonicBalance<'m> {
             names: model.dof_names().to_vec(),
             condensed: None,
         };
-        match formulation {
-            Formulation::Full => {
+        match formulation.resolve(model) {
+            Formulation::Full | Formulation::Auto => {
                 let dense = model.dense("full formulation")?;
                 hb.z = DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?;
                 hb.dense = Some(Box::new(dense));

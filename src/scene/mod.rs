@@ -515,6 +515,7 @@ impl SceneFile {
             Some(crate::solve::AutoHarmonics {
                 tolerance,
                 max_harmonics,
+                ..Default::default()
             })
         } else {
             for (field, given) in [

@@ -24,7 +24,7 @@ use crate::residual::HarmonicBalance;
 use crate::solution::Solution;
 use crate::solve::coarse::coarse_harmonics;
 use crate::solve::{robust_start, Method, Newton};
-use crate::HarmonicBasis;
+use crate::{Formulation, HarmonicBasis};
 use std::time::Instant;
 
 /// The estimated error of a solution.
@@ -55,11 +55,11 @@ const DENSE_REFINE: usize = 600;
 
 /// The refinement of `solution` on the basis with twice its harmonics (Newton from it, to a
 /// residual of 1e-12), or an error if Newton does not converge there.
-fn refine(model: &Model, solution: &Solution) -> Result<Solution> {
+fn refine(model: &Model, solution: &Solution, formulation: Formulation) -> Result<Solution> {
     let basis = solution.basis();
     let n = model.n_dofs();
     let fine = scaled(basis, 2 * basis.harmonics().max(1))?;
-    let hb = HarmonicBalance::new(model, fine)?;
+    let hb = HarmonicBalance::with_formulation(model, fine, formulation)?;
     let mut ws = hb.workspace();
     let start = crate::harmonic::embed(solution.harmonics(), n, 1, fine.harmonics());
     // From a start this close, Anderson's FFT-cost iterations on the two-level map beat a
@@ -121,7 +121,7 @@ pub fn estimate_error(model: &Model, solution: &Solution) -> Result<ErrorEstimat
             reason: "a static analysis (H = 0) averages the time variation out: no error estimate against a dynamic solution".into(),
         });
     }
-    let fine = refine(model, solution)?;
+    let fine = refine(model, solution, Formulation::Auto)?;
     Ok(compare(solution, &fine, model.n_dofs()))
 }
 
@@ -146,6 +146,8 @@ pub struct AutoHarmonics {
     pub tolerance: f64,
     /// The largest H tried (the refinement of the last level uses twice as many).
     pub max_harmonics: usize,
+    /// The formulation of every level. Default [`Formulation::Auto`].
+    pub formulation: Formulation,
 }
 
 impl Default for AutoHarmonics {
@@ -153,6 +155,7 @@ impl Default for AutoHarmonics {
         Self {
             tolerance: 1e-6,
             max_harmonics: 512,
+            formulation: Formulation::Auto,
         }
     }
 }
@@ -226,7 +229,7 @@ pub fn solve_auto(
     let n = model.n_dofs();
     let mut level_basis = scaled(&basis, basis.harmonics().max(1))?;
     let started = Instant::now();
-    let mut hb = HarmonicBalance::new(model, level_basis)?;
+    let mut hb = HarmonicBalance::with_formulation(model, level_basis, auto.formulation)?;
     let mut ws = hb.workspace();
     let mut current = robust_start(&mut hb, method, None, 1e-10, &mut ws)?.solution;
     let mut levels = Vec::new();
@@ -240,7 +243,7 @@ pub fn solve_auto(
                 ),
             });
         }
-        let fine = refine(model, &current)?;
+        let fine = refine(model, &current, auto.formulation)?;
         let estimate = compare(&current, &fine, n);
         levels.push(Level {
             harmonics: level_basis.harmonics(),
