@@ -2,7 +2,9 @@
 //!
 //! The schema is documented in `docs/scenes.md`. [`Scene::load`] parses a file, checks every
 //! field and builds the [`Model`]; every error names the file and the field path (and, for a
-//! syntax error, the line and column).
+//! syntax error, the line and column). The structural matrices may come from Matrix Market
+//! files or inline triplets and the DOF names from a sidecar list (see `matrix.rs`, `dofs.rs`
+//! and [`matrix_market`]).
 //!
 //! ```
 //! let text = r#"
@@ -25,10 +27,13 @@
 //! assert!(err.to_string().contains("elements[0].alhpa"), "{err}");
 //! ```
 
+mod dofs;
+mod matrix;
+pub mod matrix_market;
+
 use crate::force::ForceLaw;
 use crate::solve::{Anderson, Broyden, FixedPoint, Method, Newton};
 use crate::{HarmonicBasis, Model};
-use nalgebra::DMatrix;
 use serde::Deserialize;
 use serde_json::{Map, Value};
 use std::collections::BTreeMap;
@@ -116,12 +121,14 @@ struct SolverSpec {
 struct SceneFile {
     #[serde(default)]
     description: Option<String>,
-    dofs: Vec<String>,
-    mass: Vec<Vec<f64>>,
+    /// Names, `{ file }` or `{ count, prefix }` (see `dofs.rs`).
+    dofs: Value,
+    /// Dense rows, `{ file }` or `{ triplets, symmetric }` (see `matrix.rs`).
+    mass: Value,
     #[serde(default)]
-    damping: Option<Vec<Vec<f64>>>,
+    damping: Option<Value>,
     #[serde(default)]
-    stiffness: Option<Vec<Vec<f64>>>,
+    stiffness: Option<Value>,
     fundamental: Fundamental,
     harmonics: Harmonics,
     #[serde(default)]
@@ -172,7 +179,9 @@ impl Scene {
         Self::from_str(&text, &file)
     }
 
-    /// Parses scene text; the format follows the name's extension (`.json` or TOML).
+    /// Parses scene text; the format follows the name's extension (`.json` or TOML). Files the
+    /// scene names (`mass = { file = "m.mtx" }`, `dofs = { file = "dofs.txt" }`) are relative
+    /// to the directory of `file` if it exists, else to the current directory.
     #[allow(clippy::should_implement_trait)]
     pub fn from_str(text: &str, file: &str) -> Result<Scene, SceneError> {
         Self::from_value(Self::parse_value(text, file)?, file)
@@ -322,43 +331,26 @@ impl SceneFile {
             path: Some(path.to_string()),
             message,
         };
-        let n = self.dofs.len();
-        if n == 0 {
-            return Err(err("dofs", "at least one DOF is required".into()));
-        }
-        let matrix = |name: &str, rows: &Vec<Vec<f64>>| -> Result<DMatrix<f64>, SceneError> {
-            if rows.len() != n {
-                return Err(err(
-                    name,
-                    format!("expected {n} rows (one per DOF), got {}", rows.len()),
-                ));
-            }
-            for (i, r) in rows.iter().enumerate() {
-                if r.len() != n {
-                    return Err(err(
-                        &format!("{name}[{i}]"),
-                        format!("expected {n} columns (one per DOF), got {}", r.len()),
-                    ));
-                }
-            }
-            Ok(DMatrix::from_fn(n, n, |i, j| rows[i][j]))
-        };
-        let mut builder = Model::builder(&self.dofs.iter().map(|s| s.as_str()).collect::<Vec<_>>())
-            .mass(matrix("mass", &self.mass)?);
-        if let Some(d) = &self.damping {
-            builder = builder.damping(matrix("damping", d)?);
-        }
-        if let Some(k) = &self.stiffness {
-            builder = builder.stiffness(matrix("stiffness", k)?);
-        }
+        let structure = matrix::Structure::read(
+            &self.dofs,
+            &self.mass,
+            self.damping.as_ref(),
+            self.stiffness.as_ref(),
+            &matrix::base_dir(file),
+        )
+        .map_err(|(path, message)| err(&path, message))?;
+        let dofs = &structure.dofs;
+        let known: std::collections::HashSet<&str> =
+            dofs.names.iter().map(String::as_str).collect();
+        let mut builder = structure.builder();
         for (i, l) in self.loads.iter().enumerate() {
-            if !self.dofs.contains(&l.dof) {
+            if !known.contains(l.dof.as_str()) {
                 return Err(err(
                     &format!("loads[{i}].dof"),
                     format!(
                         "unknown DOF `{}` (the scene has: {})",
                         l.dof,
-                        self.dofs.join(", ")
+                        dofs.listing()
                     ),
                 ));
             }
@@ -387,13 +379,10 @@ impl SceneFile {
                 }
             };
             for dof in connects.keys() {
-                if !self.dofs.contains(dof) {
+                if !known.contains(dof.as_str()) {
                     return Err(err(
                         &at("connects"),
-                        format!(
-                            "unknown DOF `{dof}` (the scene has: {})",
-                            self.dofs.join(", ")
-                        ),
+                        format!("unknown DOF `{dof}` (the scene has: {})", dofs.listing()),
                     ));
                 }
             }
@@ -445,7 +434,10 @@ impl SceneFile {
                 connects.iter().map(|(d, w)| (d.as_str(), *w)).collect();
             builder = builder.element_boxed(&name, &weights, law);
         }
-        let model = builder.build().map_err(|e| err("model", e.to_string()))?;
+        let model = builder.build().map_err(|e| {
+            let (path, message) = structure.model_error(&e);
+            err(&path, message)
+        })?;
 
         let f = &self.fundamental;
         let given: Vec<(&str, f64)> = [("rpm", f.rpm), ("hz", f.hz), ("rad_s", f.rad_s)]

@@ -1,0 +1,690 @@
+//! FE import in scene files: structural matrices from Matrix Market files (general and symmetric
+//! storage) and inline triplets, DOF names from a sidecar list or generated. The model and its
+//! periodic solution equal those of the same scene given densely; every kind of bad input gives
+//! a message naming the file and the line (or the field and the DOF), and exit code 2.
+
+mod common;
+
+use common::hbal;
+use hbal::nalgebra::DMatrix;
+use hbal::scene::Scene;
+use hbal::{HarmonicBalance, Newton};
+use std::path::{Path, PathBuf};
+
+/// The symmetric 3-DOF chain with backlash (examples/scenes/chain_backlash.toml at W = 1.33,
+/// H = 32, where Newton converges from the linear solution), without its matrices and DOFs.
+const REST: &str = r#"
+fundamental = { rad_s = 1.33 }
+harmonics = { count = 32 }
+loads = [{ dof = "x1", order = 1, cos = 1.0 }]
+
+[[elements]]
+name = "contact"
+type = "backlash"
+connects = { x2 = -1.0, x3 = 1.0 }
+half_backlash = 1.0
+stiffness = { shape = "constant", stiffness = 5.0 }
+"#;
+
+const DENSE: &str = r#"
+dofs = ["x1", "x2", "x3"]
+mass = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+damping = [[0.1, -0.04, 0.0], [-0.04, 0.1, -0.04], [0.0, -0.04, 0.06]]
+stiffness = [[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]]
+"#;
+
+fn data_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mtx")
+}
+
+/// A fresh directory for one test's files.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hbal-mtx-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes `files` (name, text) and a scene `scene.toml` into a fresh directory; returns the
+/// scene's path.
+fn scene_with_files(test: &str, scene: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = temp_dir(test);
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    path
+}
+
+fn relative(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).amax() / b.amax().max(f64::MIN_POSITIVE)
+}
+
+/// The converged harmonics of a scene's model (Newton, tolerance 1e-13).
+fn harmonics(scene: &Scene) -> Vec<hbal::num_complex::Complex64> {
+    let hb = HarmonicBalance::new(&scene.model, scene.basis).unwrap();
+    let sol = Newton::new()
+        .with_tolerance(1e-13)
+        .unwrap()
+        .solve(&hb, &mut hb.workspace())
+        .unwrap();
+    assert!(sol.is_converged(), "{}: {}", scene.file, sol.termination);
+    sol.harmonics().to_vec()
+}
+
+/// Same matrices, same DOFs, same periodic solution (to 1e-14) as the dense scene.
+fn assert_equals_dense(scene: &Scene) {
+    let dense = Scene::from_str(&format!("{DENSE}{REST}"), "dense.toml").unwrap();
+    let (a, b) = (&scene.model, &dense.model);
+    assert_eq!(a.dof_names(), b.dof_names(), "{}", scene.file);
+    for (what, x, y) in [
+        ("mass", a.mass().clone(), b.mass().clone()),
+        ("k0", a.k0(), b.k0()),
+        ("d0", a.d0(), b.d0()),
+        (
+            "structural damping",
+            a.structural_damping().clone(),
+            b.structural_damping().clone(),
+        ),
+    ] {
+        let d = relative(&x, &y);
+        assert!(d <= 1e-14, "{}: {what} differs by {d:e}", scene.file);
+    }
+    let (ha, hb) = (harmonics(scene), harmonics(&dense));
+    let scale = hb.iter().map(|c| c.norm()).fold(0.0, f64::max);
+    let d = ha
+        .iter()
+        .zip(&hb)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f64::max);
+    assert!(
+        d <= 1e-14 * scale,
+        "{}: harmonics differ by {d:e}",
+        scene.file
+    );
+}
+
+#[test]
+fn matrix_market_files_give_the_dense_model() {
+    let dir = data_dir();
+    let dir = dir.to_str().unwrap();
+    // General storage (stiffness) and symmetric storage (an integer mass), a sidecar DOF list,
+    // absolute paths.
+    let general = format!(
+        "dofs = {{ file = \"{dir}/dofs.txt\" }}\n\
+         mass = {{ file = \"{dir}/mass_integer.mtx\" }}\n\
+         damping = {{ file = \"{dir}/damping_general.mtx\" }}\n\
+         stiffness = {{ file = \"{dir}/stiffness_general.mtx\" }}\n{REST}"
+    );
+    assert_equals_dense(&Scene::from_str(&general, "general.toml").unwrap());
+    // Symmetric storage with a repeated position, paths relative to the scene file.
+    let symmetric = format!(
+        "dofs = [\"x1\", \"x2\", \"x3\"]\n\
+         mass = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n\
+         damping = {{ file = \"damping_general.mtx\" }}\n\
+         stiffness = {{ file = \"stiffness_symmetric.mtx\" }}\n{REST}"
+    );
+    let path = data_dir().join("symmetric.toml");
+    let scene = Scene::from_str(&symmetric, path.to_str().unwrap()).unwrap();
+    assert_equals_dense(&scene);
+    // `Scene::load` resolves against the scene's directory too.
+    let loaded = Scene::load(&scene_with_files("load", &symmetric, &[])).unwrap_err();
+    assert!(
+        loaded.to_string().contains("damping_general.mtx"),
+        "{loaded}"
+    );
+    let stiffness = std::fs::read_to_string(data_dir().join("stiffness_symmetric.mtx")).unwrap();
+    let damping = std::fs::read_to_string(data_dir().join("damping_general.mtx")).unwrap();
+    let path = scene_with_files(
+        "load_ok",
+        &symmetric,
+        &[
+            ("stiffness_symmetric.mtx", &stiffness),
+            // Windows line ends.
+            ("damping_general.mtx", &damping.replace('\n', "\r\n")),
+        ],
+    );
+    assert_equals_dense(&Scene::load(&path).unwrap());
+}
+
+#[test]
+fn relative_paths_of_a_scene_text_without_a_directory_are_taken_from_the_current_directory() {
+    // `cargo test` runs in the package root.
+    let text = format!(
+        "dofs = {{ file = \"tests/data/mtx/dofs.txt\" }}\n\
+         mass = {{ file = \"tests/data/mtx/mass_integer.mtx\" }}\n\
+         damping = {{ file = \"tests/data/mtx/damping_general.mtx\" }}\n\
+         stiffness = {{ file = \"tests/data/mtx/stiffness_symmetric.mtx\" }}\n{REST}"
+    );
+    assert_equals_dense(&Scene::from_str(&text, "scene.toml").unwrap());
+    assert_equals_dense(&Scene::from_str(&text, "no/such/directory/scene.toml").unwrap());
+}
+
+#[test]
+fn inline_triplets_give_the_dense_model() {
+    // General triplets with repeated positions; symmetric = true with the upper triangle.
+    let toml = format!(
+        "dofs = [\"x1\", \"x2\", \"x3\"]\n\
+         mass = {{ triplets = [[1, 1, 0.5], [2, 2, 1.0], [3, 3, 1.0], [1, 1, 0.5]] }}\n\
+         damping = {{ triplets = [[1, 1, 0.1], [1, 2, -0.04], [2, 1, -0.04], [2, 2, 0.1], \
+                                  [2, 3, -0.04], [3, 2, -0.04], [3, 3, 0.06]] }}\n\
+         stiffness = {{ triplets = [[1, 1, 2.0], [1, 2, -1.0], [2, 2, 2.0], [2, 3, -1.0], \
+                                    [3, 3, 1.0]], symmetric = true }}\n{REST}"
+    );
+    assert_equals_dense(&Scene::from_str(&toml, "triplets.toml").unwrap());
+    // The same in JSON, lower triangle.
+    let json = r#"{
+      "dofs": ["x1", "x2", "x3"],
+      "mass": {"triplets": [[1, 1, 1], [2, 2, 1], [3, 3, 1]], "symmetric": true},
+      "damping": [[0.1, -0.04, 0.0], [-0.04, 0.1, -0.04], [0.0, -0.04, 0.06]],
+      "stiffness": {"triplets": [[1, 1, 2], [2, 1, -1], [2, 2, 2], [3, 2, -1], [3, 3, 1]],
+                    "symmetric": true},
+      "fundamental": {"rad_s": 1.33}, "harmonics": {"count": 32},
+      "loads": [{"dof": "x1", "order": 1, "cos": 1.0}],
+      "elements": [{"name": "contact", "type": "backlash", "connects": {"x2": -1.0, "x3": 1.0},
+                    "half_backlash": 1.0, "stiffness": {"shape": "constant", "stiffness": 5.0}}]
+    }"#;
+    assert_equals_dense(&Scene::from_str(json, "triplets.json").unwrap());
+    // A triplet value is a scene number: `--parameter` can sweep it.
+    let mut doc = Scene::parse_value(&toml, "triplets.toml").unwrap();
+    hbal::scene::set_parameter(&mut doc, "stiffness.triplets[0][2]", 3.0).unwrap();
+    let scene = Scene::from_value(doc, "triplets.toml").unwrap();
+    assert_eq!(scene.model.k0()[(0, 0)], 3.0);
+}
+
+#[test]
+fn generated_and_sidecar_dof_names() {
+    let chain = |dofs: &str| {
+        format!(
+            "dofs = {dofs}\nmass = {{ triplets = [[1, 1, 1.0], [2, 2, 1.0], [3, 3, 1.0]] }}\n\
+             fundamental = {{ rad_s = 1.0 }}\nharmonics = {{ count = 1 }}\n"
+        )
+    };
+    let names = |dofs: &str, file: &str| -> Vec<String> {
+        Scene::from_str(&chain(dofs), file)
+            .unwrap()
+            .model
+            .dof_names()
+            .to_vec()
+    };
+    assert_eq!(
+        names("{ count = 3, prefix = \"shaft\" }", "a.toml"),
+        ["shaft.1", "shaft.2", "shaft.3"]
+    );
+    assert_eq!(
+        names("{ count = 3 }", "a.toml"),
+        ["dof.1", "dof.2", "dof.3"]
+    );
+    let scene = data_dir().join("scene.toml");
+    assert_eq!(
+        names("{ file = \"dofs.txt\" }", scene.to_str().unwrap()),
+        ["x1", "x2", "x3"]
+    );
+    // Loads and elements refer to generated names.
+    let text = chain("{ count = 3, prefix = \"shaft\" }")
+        + "loads = [{ dof = \"shaft.3\", order = 1, cos = 1.0 }]\n";
+    let scene = Scene::from_str(&text, "a.toml").unwrap();
+    assert_eq!(scene.model.loads()[0].dof, 2);
+    // An unknown name among many: the message lists a few and the count.
+    let big = "dofs = { count = 20, prefix = \"s\" }\n\
+               mass = { triplets = [] }\n\
+               fundamental = { rad_s = 1.0 }\nharmonics = { count = 1 }\n\
+               loads = [{ dof = \"s.21\", order = 1, cos = 1.0 }]\n";
+    let err = Scene::from_str(big, "big.toml").unwrap_err().to_string();
+    assert!(
+        err.contains("loads[0].dof: unknown DOF `s.21` (the scene has: s.1, s.2,")
+            && err.contains("(20 in all (from dofs.count))"),
+        "{err}"
+    );
+}
+
+/// A 3-DOF scene around `mass`/`stiffness`/`dofs` lines, for the bad-input catalogue.
+fn bad_scene(dofs: &str, mass: &str, stiffness: &str) -> String {
+    format!(
+        "dofs = {dofs}\nmass = {mass}\nstiffness = {stiffness}\n\
+         fundamental = {{ rad_s = 1.0 }}\nharmonics = {{ count = 1 }}\n"
+    )
+}
+
+const DOFS: &str = r#"["x1", "x2", "x3"]"#;
+const MASS: &str = "{ file = \"m.mtx\" }";
+const STIFFNESS: &str = "{ file = \"k.mtx\" }";
+const GOOD_MASS: &str =
+    "%%MatrixMarket matrix coordinate real symmetric\n3 3 3\n1 1 1\n2 2 1\n3 3 1\n";
+const GOOD_K: &str =
+    "%%MatrixMarket matrix coordinate real general\n% K\n3 3 3\n1 1 2\n2 2 2\n3 3 1\n";
+
+/// Each case: name, scene text, files, the pieces its message must contain.
+type Case = (
+    &'static str,
+    String,
+    Vec<(&'static str, String)>,
+    Vec<String>,
+);
+
+fn with_k(k: &str) -> Vec<(&'static str, String)> {
+    vec![("m.mtx", GOOD_MASS.into()), ("k.mtx", k.into())]
+}
+
+fn header(kind: &str) -> String {
+    format!("%%MatrixMarket matrix {kind}\n3 3 1\n1 1 1\n")
+}
+
+fn cases() -> Vec<Case> {
+    let s = |x: &str| x.to_string();
+    let scene = bad_scene(DOFS, MASS, STIFFNESS);
+    let mut cases: Vec<Case> = vec![
+        (
+            "missing_file",
+            bad_scene(DOFS, MASS, "{ file = \"nope.mtx\" }"),
+            with_k(GOOD_K),
+            vec![s("stiffness.file: "), s("nope.mtx: cannot read the Matrix Market file")],
+        ),
+        (
+            "not_mtx",
+            scene.clone(),
+            with_k("3 3 1\n1 1 1\n"),
+            vec![s("k.mtx:1: not a Matrix Market file"), s("got `3 3 1`")],
+        ),
+        (
+            "empty_file",
+            scene.clone(),
+            with_k(""),
+            vec![s("k.mtx:1: not a Matrix Market file")],
+        ),
+        (
+            "short_header",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real\n3 3 1\n1 1 1\n"),
+            vec![s("k.mtx:1: unsupported Matrix Market type"), s("expected 4 words")],
+        ),
+        (
+            "no_size_line",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n% nothing\n"),
+            vec![s("k.mtx:2: the file ends before the size line")],
+        ),
+        (
+            "bad_size_line",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3\n1 1 1\n"),
+            vec![s("k.mtx:2: expected the size line `rows columns entries`"), s("got `3 3`")],
+        ),
+        (
+            "malformed_entry",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 2\n1 1 1.0\n2 2\n"),
+            vec![s("k.mtx:4: expected an entry `row column value`, got `2 2`")],
+        ),
+        (
+            "bad_index",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 1\n1.5 1 1.0\n"),
+            vec![s("k.mtx:3: row index `1.5` is not a whole number")],
+        ),
+        (
+            "bad_value",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 1\n1 1 stiff\n"),
+            vec![s("k.mtx:3: value `stiff` is not a number")],
+        ),
+        (
+            "bad_integer",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate integer general\n3 3 1\n1 1 1.5\n"),
+            vec![s("k.mtx:3: value `1.5` is not an integer (the header says `integer`)")],
+        ),
+        (
+            "index_out_of_range",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 2\n1 1 1.0\n3 4 1.0\n"),
+            vec![s("k.mtx:4: column 4 is outside 1..=3")],
+        ),
+        (
+            "index_zero",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 1\n0 1 1.0\n"),
+            vec![s("k.mtx:3: row 0 is outside 1..=3"), s("1-based")],
+        ),
+        (
+            "upper_triangle",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real symmetric\n3 3 2\n1 1 1.0\n1 2 1.0\n"),
+            vec![s("k.mtx:4: entry (1, 2) lies above the diagonal")],
+        ),
+        (
+            "too_few_entries",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 3\n1 1 1.0\n2 2 1.0\n"),
+            vec![s("k.mtx:4: the file ends after 2 of the 3 entries declared on line 2")],
+        ),
+        (
+            "too_many_entries",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 1\n1 1 1.0\n2 2 1.0\n"),
+            vec![s("k.mtx:4: more entries than the 1 declared on line 2")],
+        ),
+        (
+            "nan",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 1\n1 1 NaN\n"),
+            vec![s("k.mtx:3: value `NaN` is not finite")],
+        ),
+        (
+            "overflow",
+            scene.clone(),
+            with_k("%%MatrixMarket matrix coordinate real general\n3 3 2\n1 1 1\n2 2 -1e999\n"),
+            vec![s("k.mtx:4: value `-1e999` is not finite")],
+        ),
+        (
+            "five_for_four",
+            bad_scene(r#"["a", "b", "c", "d"]"#, "{ triplets = [[1, 1, 1], [2, 2, 1], [3, 3, 1], [4, 4, 1]] }", STIFFNESS),
+            with_k("%%MatrixMarket matrix coordinate real general\n5 5 1\n5 5 1.0\n"),
+            vec![s("stiffness.file: "), s("k.mtx:2: the matrix is 5 x 5, but the scene has 4 DOFs")],
+        ),
+        (
+            "sidecar_count",
+            bad_scene("{ file = \"dofs.txt\" }", MASS, STIFFNESS),
+            vec![
+                ("m.mtx", GOOD_MASS.into()),
+                ("k.mtx", GOOD_K.into()),
+                ("dofs.txt", "x1\nx2\nx3\nx4\n".into()),
+            ],
+            vec![
+                s("mass.file: "),
+                s("m.mtx:2: the matrix is 3 x 3, but the scene has 4 DOFs (from "),
+                s("dofs.txt)"),
+            ],
+        ),
+        (
+            "sidecar_duplicate",
+            bad_scene("{ file = \"dofs.txt\" }", MASS, STIFFNESS),
+            vec![
+                ("m.mtx", GOOD_MASS.into()),
+                ("k.mtx", GOOD_K.into()),
+                ("dofs.txt", "# names\nx1\nx2 # middle\n\nx2\n".into()),
+            ],
+            vec![s("dofs.file: "), s("dofs.txt:5: DOF `x2` appears twice (first on line 3)")],
+        ),
+        (
+            "sidecar_missing",
+            bad_scene("{ file = \"dofs.txt\" }", MASS, STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("dofs.file: "), s("dofs.txt: cannot read the DOF list")],
+        ),
+        (
+            "sidecar_empty",
+            bad_scene("{ file = \"dofs.txt\" }", MASS, STIFFNESS),
+            vec![("dofs.txt", "# nothing\n\n".into())],
+            vec![s("dofs.file: at least one DOF is required (from "), s("dofs.txt)")],
+        ),
+        (
+            "asymmetric_mass",
+            scene.clone(),
+            vec![
+                (
+                    "m.mtx",
+                    "%%MatrixMarket matrix coordinate real general\n3 3 4\n1 1 1\n2 2 1\n3 3 1\n3 1 0.25\n"
+                        .into(),
+                ),
+                ("k.mtx", GOOD_K.into()),
+            ],
+            vec![
+                s("mass.file: mass matrix is not symmetric positive definite: not symmetric"),
+                s("(the mass matrix from "),
+                s("m.mtx)"),
+                s("; row 3, column 1 is 2.5e-1 but row 1, column 3 is 0e0 (1-based)"),
+            ],
+        ),
+        (
+            "singular_mass",
+            scene.clone(),
+            vec![
+                ("m.mtx", "%%MatrixMarket matrix coordinate real symmetric\n3 3 2\n1 1 1\n2 2 1\n".into()),
+                ("k.mtx", GOOD_K.into()),
+            ],
+            vec![s("mass.file: mass matrix is not symmetric positive definite: Cholesky"), s("m.mtx)")],
+        ),
+        (
+            "triplet_out_of_range",
+            bad_scene(DOFS, "{ triplets = [[1, 1, 1.0], [4, 4, 1.0]] }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass.triplets[1]: row 4 is outside the 3 DOFs (indices 1 to 3)")],
+        ),
+        (
+            "triplet_zero",
+            bad_scene(DOFS, "{ triplets = [[1, 0, 1.0]] }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass.triplets[0]: column must be a whole number ≥ 1 (indices are 1-based), got 0")],
+        ),
+        (
+            "triplet_float_index",
+            bad_scene(DOFS, "{ triplets = [[1.0, 1, 1.0]] }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass.triplets[0]: row must be a whole number ≥ 1"), s("got 1.0")],
+        ),
+        (
+            "triplet_shape",
+            bad_scene(DOFS, "{ triplets = [[1, 1]] }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass.triplets[0]: expected [row, column, value], got [1,1]")],
+        ),
+        (
+            "triplet_value",
+            bad_scene(DOFS, "{ triplets = [[1, 1, \"heavy\"]] }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass.triplets[0]: value must be a finite number, got \"heavy\"")],
+        ),
+        (
+            "triplet_nan",
+            bad_scene(DOFS, "{ triplets = [[1, 1, nan]] }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass.triplets[0][2]: must be a finite number, got NaN")],
+        ),
+        (
+            "triplet_both_triangles",
+            bad_scene(
+                DOFS,
+                MASS,
+                "{ triplets = [[1, 1, 2.0], [1, 2, -1.0], [3, 3, 1.0], [2, 1, -1.0]], symmetric = true }",
+            ),
+            with_k(GOOD_K),
+            vec![s(
+                "stiffness.triplets[3]: with `symmetric = true` give one triangle only, but \
+                 triplets[1] lies above the diagonal and triplets[3] below it",
+            )],
+        ),
+        (
+            "file_and_triplets",
+            bad_scene(DOFS, "{ file = \"m.mtx\", triplets = [] }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass: give exactly one of `file` (a Matrix Market file) and `triplets`")],
+        ),
+        (
+            "symmetric_file",
+            bad_scene(DOFS, "{ file = \"m.mtx\", symmetric = true }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass.symmetric: applies to `triplets` only")],
+        ),
+        (
+            "misspelled_file",
+            bad_scene(DOFS, "{ fiel = \"m.mtx\" }", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass.fiel: unknown field `fiel`, expected one of `file`, `triplets`, `symmetric`")],
+        ),
+        (
+            "matrix_type",
+            bad_scene(DOFS, "3.0", STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("mass: invalid type: number `3.0`, expected a list of rows")],
+        ),
+        (
+            "dofs_count_zero",
+            bad_scene("{ count = 0 }", "{ triplets = [] }", "{ triplets = [] }"),
+            vec![],
+            vec![s("dofs.count: at least one DOF is required")],
+        ),
+        (
+            "dofs_file_and_count",
+            bad_scene("{ file = \"dofs.txt\", count = 3 }", MASS, STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("dofs: give a list of names, `{ file = \"dofs.txt\" }`")],
+        ),
+        (
+            "dofs_prefix_with_file",
+            bad_scene("{ file = \"dofs.txt\", prefix = \"x\" }", MASS, STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("dofs.prefix: applies to `count` only")],
+        ),
+        (
+            "dofs_unknown_field",
+            bad_scene("{ cuont = 3 }", MASS, STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("dofs.cuont: unknown field `cuont`")],
+        ),
+    ];
+    for (kind, words) in [
+        ("coordinate complex general", "complex values"),
+        (
+            "coordinate pattern general",
+            "a `pattern` file has no values",
+        ),
+        ("array real general", "dense `array` storage"),
+        ("coordinate real hermitian", "hermitian storage"),
+        ("coordinate real skew-symmetric", "skew-symmetric storage"),
+        ("vector coordinate real general", "expected 4 words"),
+    ] {
+        cases.push((
+            "unsupported",
+            scene.clone(),
+            with_k(&header(kind)),
+            vec![
+                format!(
+                    "stiffness.file: {{dir}}k.mtx:1: unsupported Matrix Market type in \
+                     `%%MatrixMarket matrix {kind}`: {words}"
+                ),
+                s("hbal reads `%%MatrixMarket matrix coordinate real general`"),
+            ],
+        ));
+    }
+    cases
+}
+
+#[test]
+fn bad_input_names_the_file_and_the_line() {
+    for (k, (name, scene, files, expected)) in cases().into_iter().enumerate() {
+        let files: Vec<(&str, &str)> = files.iter().map(|(n, t)| (*n, t.as_str())).collect();
+        let path = scene_with_files(&format!("bad{k}"), &scene, &files);
+        let dir = format!("{}/", path.parent().unwrap().display());
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(
+            err.starts_with(&path.display().to_string()),
+            "{name}: the message must name the scene: {err}"
+        );
+        for piece in expected {
+            let piece = piece.replace("{dir}", &dir);
+            assert!(err.contains(&piece), "{name}: `{err}` lacks `{piece}`");
+        }
+    }
+}
+
+#[test]
+fn cli_solves_the_example_and_refuses_bad_files_with_exit_code_2() {
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/chain_mtx.toml");
+    let p = example.to_str().unwrap();
+    for command in ["check", "solve"] {
+        let out = hbal(&[command, p]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{command}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let out = hbal(&["solve", p, "--json", "--no-stability"]);
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["converged"], true);
+    assert_eq!(doc["dofs"][2]["name"], "x3");
+
+    // The example's matrices equal chain_backlash.toml's.
+    let mtx = Scene::load(&example).unwrap();
+    let dense = Scene::load(&example.with_file_name("chain_backlash.toml")).unwrap();
+    assert_eq!(mtx.model.mass(), dense.model.mass());
+    assert_eq!(mtx.model.k0(), dense.model.k0());
+    assert_eq!(mtx.model.d0(), dense.model.d0());
+
+    let path = scene_with_files(
+        "cli",
+        &bad_scene(DOFS, MASS, STIFFNESS),
+        &with_k("%%MatrixMarket matrix coordinate real general\n% K\n3 3 1\n1 x 2.0\n")
+            .iter()
+            .map(|(n, t)| (*n, t.as_str()))
+            .collect::<Vec<_>>(),
+    );
+    for command in ["check", "solve"] {
+        let out = hbal(&[command, path.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{command}: {err}");
+        assert!(
+            err.contains("k.mtx:4: column index `x` is not a whole number"),
+            "{command}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+/// A 1000-DOF chain from Matrix Market files and generated names: read and built quickly
+/// (the time is printed; `cargo test --release --test matrix_import -- --nocapture`).
+#[test]
+fn a_thousand_dof_chain_reads_quickly() {
+    let n = 1000;
+    let mut k = format!(
+        "%%MatrixMarket matrix coordinate real symmetric\n% chain of {n} unit springs\n{n} {n} {}\n",
+        2 * n - 1
+    );
+    let mut m = format!("%%MatrixMarket matrix coordinate real general\n{n} {n} {n}\n");
+    for i in 1..=n {
+        k += &format!("{i} {i} {}\n", if i == n { 1.0 } else { 2.0 });
+        if i > 1 {
+            k += &format!("{i} {} -1.0\n", i - 1);
+        }
+        m += &format!("{i} {i} 1.0e-3\n");
+    }
+    let scene = format!(
+        "dofs = {{ count = {n}, prefix = \"shaft\" }}\nmass = {{ file = \"m.mtx\" }}\n\
+         stiffness = {{ file = \"k.mtx\" }}\nfundamental = {{ rad_s = 1.0 }}\n\
+         harmonics = {{ count = 1 }}\nloads = [{{ dof = \"shaft.{n}\", order = 1, cos = 1.0 }}]\n"
+    );
+    let path = scene_with_files("big", &scene, &[("m.mtx", &m), ("k.mtx", &k)]);
+    let start = std::time::Instant::now();
+    let read = hbal::scene::matrix_market::read(&path.with_file_name("k.mtx")).unwrap();
+    let t_read = start.elapsed();
+    assert_eq!(read.entries.len(), 3 * n - 2);
+    let start = std::time::Instant::now();
+    let scene = Scene::load(&path).unwrap();
+    let t_load = start.elapsed();
+    let k0 = scene.model.k0();
+    assert_eq!(
+        (k0[(0, 0)], k0[(1, 0)], k0[(n - 1, n - 1)]),
+        (2.0, -1.0, 1.0)
+    );
+    assert_eq!(scene.model.dof_names()[n - 1], format!("shaft.{n}"));
+    // The share of the (dense) model builder: assembly, symmetry check, Cholesky.
+    let names: Vec<&str> = scene.model.dof_names().iter().map(String::as_str).collect();
+    let start = std::time::Instant::now();
+    hbal::Model::builder(&names)
+        .mass(scene.model.mass().clone())
+        .stiffness_triplets(&read.entries)
+        .build()
+        .unwrap();
+    let t_build = start.elapsed();
+    println!(
+        "{n}-DOF chain: stiffness.mtx ({} bytes) read in {:.3} ms; the whole scene (2 files) \
+         loaded in {:.1} ms, of which {:.1} ms in ModelBuilder::build (dense)",
+        k.len(),
+        t_read.as_secs_f64() * 1e3,
+        t_load.as_secs_f64() * 1e3,
+        t_build.as_secs_f64() * 1e3
+    );
+    assert!(t_load.as_secs_f64() < 20.0, "{t_load:?}");
+}
