@@ -3,6 +3,7 @@
 //! condensation onto the element coordinates through the receptances `G_k = Wᵀ Z_k⁻¹ W`.
 
 pub mod condensation;
+pub mod envelope;
 pub mod sparse_stiffness;
 
 pub use condensation::Condensation;

@@ -24,7 +24,7 @@
 //! "#;
 //! let scene = hbal::scene::Scene::from_str(text, "chain.toml").unwrap();
 //! assert_eq!(scene.model.dof_names(), ["x.1", "x.2"]);
-//! assert_eq!(scene.model.k0()[(0, 1)], -1.0);
+//! assert_eq!(scene.model.k0().get(0, 1), -1.0);
 //! let bad = text.replace("[2, 2, 1.0]]", "[3, 3, 1.0]]");
 //! let err = hbal::scene::Scene::from_str(&bad, "chain.toml").unwrap_err().to_string();
 //! assert!(err.contains("mass.triplets[1]: row 3 is outside the 2 DOFs"), "{err}");
