@@ -31,7 +31,11 @@ fn dof_count_is_the_requested_one() {
             let d = base.clone().with_dofs(n);
             assert_eq!(d.n_dofs(), n.max(min), "m = {meshes}, n = {n}");
             if n <= 100 {
-                assert_eq!(d.model().unwrap().n_dofs(), d.n_dofs(), "m = {meshes}, n = {n}");
+                assert_eq!(
+                    d.model().unwrap().n_dofs(),
+                    d.n_dofs(),
+                    "m = {meshes}, n = {n}"
+                );
             }
         }
     }
@@ -79,7 +83,11 @@ fn the_model_is_a_valid_drivetrain() {
     let v = model.dof_index("vehicle").unwrap();
     for i in 0..n {
         let f: f64 = (0..n).map(|j| k0[(i, j)] * speed[j]).sum();
-        let expected = if i == v { d.vehicle.ground_stiffness * s } else { 0.0 };
+        let expected = if i == v {
+            d.vehicle.ground_stiffness * s
+        } else {
+            0.0
+        };
         assert!((f - expected).abs() < 1e-9 * k0.amax(), "{}: {f}", names[i]);
     }
     let work: f64 = model
@@ -116,7 +124,10 @@ fn firing_order_phases() {
         let (c, s) = sum(k);
         if k % 4 == 0 {
             let a = Drivetrain::default().engine.gas_orders[k - 1];
-            assert!((c - 4.0 * a * t).abs() < 1e-9 && s.abs() < 1e-9, "{k}: {c} {s}");
+            assert!(
+                (c - 4.0 * a * t).abs() < 1e-9 && s.abs() < 1e-9,
+                "{k}: {c} {s}"
+            );
         } else {
             assert!(c.abs() < 1e-9 && s.abs() < 1e-9, "{k}: {c} {s}");
         }
@@ -128,10 +139,7 @@ fn firing_order_phases() {
 /// mesh and the clutch.
 #[test]
 fn full_and_condensed_agree() {
-    let d = Drivetrain::default()
-        .coarse_teeth(4)
-        .unwrap()
-        .with_dofs(30);
+    let d = Drivetrain::default().coarse_teeth(4).unwrap().with_dofs(30);
     assert_eq!(d.mesh_orders().unwrap(), [8, 8, 5, 3]);
     let model = d.model().unwrap();
     let h = 16;
@@ -164,10 +172,7 @@ fn full_and_condensed_agree() {
 /// the vibration (inertia and damping torques average out): its mean twist is `T L / (G Jp)`.
 #[test]
 fn static_twist_of_the_shafts() {
-    let d = Drivetrain::default()
-        .coarse_teeth(4)
-        .unwrap()
-        .with_dofs(32);
+    let d = Drivetrain::default().coarse_teeth(4).unwrap().with_dofs(32);
     let model = d.model().unwrap();
     let basis = HarmonicBasis::new(d.fundamental(RPM), 8).unwrap();
     let sol = solve(&model, basis, Formulation::Condensed);
@@ -175,20 +180,33 @@ fn static_twist_of_the_shafts() {
     let end = |name: &str, shaft: &Shaft| format!("{name}.{}", shaft.segments);
     let twist = mean("hub") - mean(&end("input", &d.input_shaft));
     let expected = d.input_shaft.twist(d.drive_torque);
-    assert!(((twist - expected) / expected).abs() < 1e-9, "input: {twist} vs {expected}");
+    assert!(
+        ((twist - expected) / expected).abs() < 1e-9,
+        "input: {twist} vs {expected}"
+    );
     // Shaft 1 carries T · i_1 from gear 1 to pinion 2.
     let s1 = &d.gearbox[0].shaft;
     let twist = mean("gear1") - mean(&end("shaft1", s1));
     let expected = s1.twist(d.drive_torque * d.gearbox[0].pair.ratio());
-    assert!(((twist - expected) / expected).abs() < 1e-9, "shaft 1: {twist} vs {expected}");
+    assert!(
+        ((twist - expected) / expected).abs() < 1e-9,
+        "shaft 1: {twist} vs {expected}"
+    );
     // The propeller shaft carries T times the gearbox ratio.
     let gearbox: f64 = d.gearbox.iter().map(|s| s.pair.ratio()).product();
     let prop_start = end("shaft3", &d.gearbox[2].shaft);
     let twist = mean(&prop_start) - mean(&end("prop", &d.propeller_shaft));
     let expected = d.propeller_shaft.twist(d.drive_torque * gearbox);
-    assert!(((twist - expected) / expected).abs() < 1e-9, "prop: {twist} vs {expected}");
+    assert!(
+        ((twist - expected) / expected).abs() < 1e-9,
+        "prop: {twist} vs {expected}"
+    );
     // The loads balance, so the ground spring carries no mean torque.
-    assert!(mean("vehicle").abs() < 1e-9 * mean("throw1").abs(), "{}", mean("vehicle"));
+    assert!(
+        mean("vehicle").abs() < 1e-9 * mean("throw1").abs(),
+        "{}",
+        mean("vehicle")
+    );
 }
 
 #[test]

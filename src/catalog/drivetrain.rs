@@ -33,7 +33,7 @@
 //! fundamental cannot be the mesh frequency instead: the engine orders would not be whole
 //! multiples of it. The default teeth keep every mesh at or below harmonic 32 (m = 4: mesh
 //! harmonics 32, 32, 20, 12), so H = 32 is the smallest basis (`HarmonicBalance::new`
-//! refuses less, [`Error::ElementOrderTooHigh`](crate::Error::ElementOrderTooHigh)); it resolves the
+//! refuses less, [`Error::ElementOrderTooHigh`]); it resolves the
 //! first harmonic of the fastest mesh's stiffness variation, H = 64 or 128 its second and
 //! fourth. That needs a first pinion of at most 16 teeth on the input shaft: few, but real
 //! (low-gear pinions have 11 to 16). [`Drivetrain::coarse_teeth`] divides every tooth count
@@ -42,8 +42,9 @@
 //! **Loads.** The mean drive torque `T` (N m), a quarter on each throw, balanced by
 //! `-T i` at the vehicle (i the overall ratio), so the ground spring carries no static torque;
 //! and per cylinder c the gas-torque harmonics `a_j (T/4) cos(j(θ - α_c/2))`, j = 1, 2, ...,
-//! with `α_c` the crank angle at which c fires (firing order 1-3-4-2, every 180°): orders that
-//! are not multiples of 2 cancel on a rigid crank and act only through its twist.
+//! with `α_c` the crank angle at which c fires (firing order 1-3-4-2, every 180°): crank orders
+//! that are not multiples of 2 (harmonics not multiples of 4) cancel on a rigid crank and act
+//! only through its twist.
 //!
 //! **Size.** `n = 10 + e_in + e_prop + e_left + e_right + Σ_j (1 + e_j)` for `e` segments per
 //! shaft (20 DOFs at one segment each with m = 4, 14 with m = 1);
@@ -65,11 +66,11 @@
 //! ```
 
 mod assembly;
+mod engine;
 mod parts;
 
-pub use parts::{
-    ClutchDamper, Engine, GearPair, GearStage, Shaft, Vehicle, STEEL_DENSITY, STEEL_SHEAR_MODULUS,
-};
+pub use engine::{ClutchDamper, Engine};
+pub use parts::{GearPair, GearStage, Shaft, Vehicle, STEEL_DENSITY, STEEL_SHEAR_MODULUS};
 
 use crate::error::{check_finite, check_non_negative, check_positive, Error, Result};
 use crate::model::Model;
@@ -273,7 +274,7 @@ impl Drivetrain {
                     "an integer >= 1",
                 ));
             }
-            let order = num.checked_mul(2 * zp).unwrap_or(u128::MAX);
+            let order = num.saturating_mul(2 * zp);
             if order % den != 0 || order / den > u32::MAX as u128 {
                 return Err(Error::invalid(
                     format!("drivetrain mesh {}", j + 1),

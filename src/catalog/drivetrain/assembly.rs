@@ -95,7 +95,12 @@ pub(super) fn build(d: &Drivetrain) -> Result<Model> {
         prev = *t;
     }
     let flywheel = a.node("flywheel".into(), e.flywheel);
-    a.couple(prev, flywheel, e.flange_stiffness, beta * e.flange_stiffness);
+    a.couple(
+        prev,
+        flywheel,
+        e.flange_stiffness,
+        beta * e.flange_stiffness,
+    );
 
     // Clutch damper: idle stage (and the main stage if linear) in K.
     let cl = &d.clutch;
