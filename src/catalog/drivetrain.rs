@@ -99,7 +99,7 @@ pub struct Drivetrain {
     /// Wheels, tyres and vehicle.
     pub vehicle: Vehicle,
     /// Material damping of crank and shaft sections, `d = β k`, β in s (2e-5 s: ζ = βω/2 ≈
-    /// 0.02 at the crank's 2.2e3 rad/s).
+    /// 0.05 at the crank's first mode, 5.3e3 rad/s).
     pub shaft_beta: f64,
     /// Mean engine torque T (N m).
     pub drive_torque: f64,
