@@ -6,6 +6,9 @@ use crate::model::Model;
 use nalgebra::DMatrix;
 use std::f64::consts::TAU;
 
+pub mod drivetrain;
+pub use drivetrain::Drivetrain;
+
 /// The paper's two-shaft model (Bauer et al. 2021, section 4) with the values of hbal's issue 2
 /// (shared with `../shared/reference/seed_rect_6000rpm.json`).
 ///
