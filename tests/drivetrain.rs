@@ -53,7 +53,10 @@ fn the_model_is_a_valid_drivetrain() {
     let d = Drivetrain::default().with_dofs(60);
     let model = d.model().unwrap();
     let n = model.n_dofs();
-    let (m, k) = (model.mass(), model.structural_stiffness());
+    let (m, k) = (
+        model.mass().to_dense(),
+        model.structural_stiffness().to_dense(),
+    );
     // Lumped inertias: a positive diagonal.
     for i in 0..n {
         assert!(m[(i, i)] > 0.0, "{}", model.dof_names()[i]);
@@ -79,7 +82,7 @@ fn the_model_is_a_valid_drivetrain() {
         }
         speed[i] = s;
     }
-    let k0 = model.k0();
+    let k0 = model.k0().to_dense();
     let v = model.dof_index("vehicle").unwrap();
     for i in 0..n {
         let f: f64 = (0..n).map(|j| k0[(i, j)] * speed[j]).sum();

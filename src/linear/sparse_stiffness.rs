@@ -76,9 +76,12 @@ impl SparsePattern {
         }
     }
 
-    /// `true` if `M`, `D0`, `K0` are symmetric (exactly: they are assembled symmetric).
+    /// `true` if `M`, `D0`, `K0` are symmetric to rounding (1e-13 of each one's largest
+    /// entry: an assembly sums `(i, j)` and `(j, i)` in different orders).
     fn is_symmetric(&self) -> bool {
         let n = self.n;
+        let amax = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let tol = [amax(&self.m), amax(&self.d), amax(&self.k)].map(|a| 1e-13 * a);
         (0..n).all(|j| {
             (self.col_ptr[j]..self.col_ptr[j + 1]).all(|p| {
                 let i = self.row_idx[p];
@@ -86,7 +89,9 @@ impl SparsePattern {
                 match self.row_idx[s.clone()].binary_search(&j) {
                     Ok(q) => {
                         let q = s.start + q;
-                        self.m[q] == self.m[p] && self.d[q] == self.d[p] && self.k[q] == self.k[p]
+                        (self.m[q] - self.m[p]).abs() <= tol[0]
+                            && (self.d[q] - self.d[p]).abs() <= tol[1]
+                            && (self.k[q] - self.k[p]).abs() <= tol[2]
                     }
                     Err(_) => false,
                 }
