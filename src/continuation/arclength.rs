@@ -282,9 +282,13 @@ impl Continuation {
         hb.layout().unpack(x, &mut unknowns);
         // All DOFs (the condensed formulation recovers them from the coordinates; `hb` sits
         // at `omega` after the corrector).
-        let harmonics = match hb.full_harmonics(&unknowns, &mut hb.workspace().eval) {
-            Ok(h) => h,
-            Err(e) => return Some(e.to_string()),
+        let harmonics = if hb.is_condensed() {
+            match hb.full_harmonics(&unknowns, &mut hb.workspace().eval) {
+                Ok(h) => h,
+                Err(e) => return Some(e.to_string()),
+            }
+        } else {
+            unknowns
         };
         let basis = match hb.basis().with_omega(omega) {
             Ok(b) => b,
