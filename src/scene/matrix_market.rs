@@ -268,3 +268,39 @@ fn entry(
     }
     Ok((i, j, value))
 }
+
+/// Writes `a` as a Matrix Market coordinate file: `real symmetric` storage (the lower
+/// triangle) when `a` is symmetric to rounding (`asymmetry <= 1e-13` of its largest entry, as
+/// assembly leaves it), else `real general`. Values are written in Rust's shortest
+/// round-trip form, so [`read`] gives back the same numbers (the lower triangle's where the
+/// storage is symmetric). `comment` becomes `%` lines after the header.
+///
+/// ```
+/// use hbal::model::SparseMatrix;
+/// use hbal::scene::matrix_market::{parse, write};
+/// let k = SparseMatrix::from_triplets(2, &[(0, 0, 2.0), (1, 0, -1.0), (0, 1, -1.0), (1, 1, 0.1)]);
+/// let mut text = Vec::new();
+/// write(&mut text, &k, "a 2 x 2 spring").unwrap();
+/// let m = parse(std::str::from_utf8(&text).unwrap(), "k.mtx").unwrap();
+/// assert!(m.symmetric);
+/// assert_eq!(m.entries, vec![(0, 0, 2.0), (1, 0, -1.0), (0, 1, -1.0), (1, 1, 0.1)]);
+/// ```
+pub fn write(
+    out: &mut impl std::io::Write,
+    a: &crate::model::SparseMatrix,
+    comment: &str,
+) -> std::io::Result<()> {
+    let symmetric = a.asymmetry() <= 1e-13 * a.amax();
+    let kept = |i: usize, j: usize, v: f64| v != 0.0 && (!symmetric || i >= j);
+    let entries = a.iter().filter(|&(i, j, v)| kept(i, j, v)).count();
+    let storage = if symmetric { "symmetric" } else { "general" };
+    let mut text = format!("%%MatrixMarket matrix coordinate real {storage}\n");
+    for line in comment.lines() {
+        text.push_str(&format!("% {line}\n"));
+    }
+    text.push_str(&format!("{} {} {entries}\n", a.n(), a.n()));
+    for (i, j, v) in a.iter().filter(|&(i, j, v)| kept(i, j, v)) {
+        text.push_str(&format!("{} {} {v:e}\n", i + 1, j + 1));
+    }
+    out.write_all(text.as_bytes())
+}

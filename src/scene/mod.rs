@@ -28,6 +28,7 @@
 //! ```
 
 mod dofs;
+pub mod export;
 mod matrix;
 pub mod matrix_market;
 

@@ -170,7 +170,8 @@ pub fn highest_natural_frequency(model: &Model) -> Option<f64> {
 /// The coarse harmonics for the two-level map on `basis`: every harmonic up to 1.5 times
 /// the highest natural frequency of `(M, K0)` (above it, `Z_k` dominates the coupling and the
 /// per-harmonic step contracts), at least 32 and every order of the model, at most
-/// [`MAX_COARSE_UNKNOWNS`] real unknowns. `None` if that is not below `H` (use Newton).
+/// [`MAX_COARSE_UNKNOWNS`] real unknowns. `None` if that is not below `H` or the cap does not
+/// reach the model's highest order (use Newton).
 pub fn coarse_harmonics(model: &Model, basis: &HarmonicBasis) -> Option<usize> {
     coarse_harmonics_within(model, basis, MAX_COARSE_UNKNOWNS)
 }
@@ -184,16 +185,19 @@ pub fn coarse_harmonics_within(
     max_unknowns: usize,
 ) -> Option<usize> {
     let n = model.n_dofs().max(1);
+    let cap = (max_unknowns / n).saturating_sub(1) / 2;
+    let least = model.max_order() * basis.subharmonic();
+    if cap < least.max(1) {
+        // The block cannot hold every order of the model (a large model): no two-level map,
+        // and no dense eigenvalue problem of (M, K0) to find that out.
+        return None;
+    }
     let fundamental = basis.fundamental();
     let resonant = highest_natural_frequency(model)
         .map(|w| (1.5 * w / fundamental).ceil())
         .filter(|h| h.is_finite())
         .unwrap_or(0.0)
         .min(1e9) as usize;
-    let cap = (max_unknowns / n).saturating_sub(1) / 2;
-    let hc = resonant
-        .max(32)
-        .max(model.max_order() * basis.subharmonic())
-        .min(cap.max(1));
+    let hc = resonant.max(32).max(least).min(cap);
     (hc < basis.harmonics()).then_some(hc)
 }
