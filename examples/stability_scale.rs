@@ -30,8 +30,8 @@ fn main() -> hbal::Result<()> {
     let max_dofs = argument("--max-dofs", 10_000);
     let dense_up_to = argument("--dense-up-to", 100);
     println!("## Floquet multipliers of the drivetrain (m = 4, H = 32, {RPM} rpm)\n");
-    println!("| n | HB point ms | basis r + a | dense ms | reduced ms | with estimate ms | max abs(μ) dense | max abs(μ) reduced | estimate | distance to dense | steps |");
-    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| n | HB point ms | basis r + a | dense ms | reduced ms | with estimate ms | max abs(μ) dense | max abs(μ) reduced | estimate | distance to dense | neutral | steps |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     let mut sweep = None;
     for n in [20, 100, 1000, 10_000]
         .into_iter()
@@ -86,12 +86,14 @@ fn main() -> hbal::Result<()> {
             None => ("-".into(), "-".into(), "-".into()),
         };
         println!(
-            "| {n} | {t_hb:.1} | {} + {} | {t_dense} | {t_reduced:.1} | {t_estimated:.1} | {mu_dense} | {:.6} | {:.1e} (against {}) | {distance} | {} |",
+            "| {n} | {t_hb:.1} | {} + {} | {t_dense} | {t_reduced:.1} | {t_estimated:.1} | {mu_dense} | {:.6} | {:.1e} (against {}) | {distance} | {} / {} | {} |",
             info.modes,
             info.attachment,
             reduced.max_abs(),
             info.estimate.unwrap_or(f64::NAN),
             info.comparison_dofs.unwrap_or(0),
+            reduced.neutral,
+            estimated.neutral,
             reduced.steps,
         );
         if n == 1000 {

@@ -97,3 +97,63 @@ fn every_mode_kept_gives_the_dense_multipliers() {
         assert_eq!(dense.is_stable(), reduced.is_stable(), "{label}");
     }
 }
+
+/// The drivetrain at n = 100 (coarse teeth, H = 8, 6000 rpm): the automatic cut-off keeps about
+/// a fifth of the coordinates; the estimate (against twice the cut-off) must bound the true
+/// distance to the dense multipliers within a factor 3, and both say the same about stability.
+/// About a minute in release (`cargo test --release --test stability_at_scale`).
+#[test]
+fn the_estimate_of_the_cut_off_basis_is_truthful() {
+    let d = Drivetrain::default()
+        .coarse_teeth(4)
+        .unwrap()
+        .with_dofs(100);
+    let model = d.model().unwrap();
+    let basis = HarmonicBasis::new(d.fundamental(6000.0), 8).unwrap();
+    let solution = solve(&model, basis, Formulation::Condensed);
+    let (dense, reduced) = both(&model, &solution, FloquetOptions::default());
+    let info = reduced.reduction.clone().unwrap();
+    let estimate = info.estimate.unwrap();
+    // The leading multipliers (those the estimate covers) against the dense ones.
+    let top = dense.max_abs().max(reduced.max_abs());
+    let lead = |a: &[Complex64]| -> Vec<Complex64> {
+        a.iter()
+            .take(8)
+            .filter(|m| m.norm() >= 0.5 * top)
+            .copied()
+            .collect()
+    };
+    let error = one_way(&lead(&reduced.multipliers), &dense.multipliers)
+        .max(one_way(&lead(&dense.multipliers), &reduced.multipliers));
+    eprintln!(
+        "n = 100: basis {} + {} (comparison {:?}), max |μ| {:.9} dense, {:.9} reduced, error {error:.2e}, estimate {estimate:.2e}",
+        info.modes,
+        info.attachment,
+        info.comparison_dofs,
+        dense.max_abs(),
+        reduced.max_abs()
+    );
+    assert!(info.dofs < 40, "{} coordinates", info.dofs);
+    assert!(error < 1e-3, "{error:e}");
+    assert!(
+        error <= 3.0 * estimate + 1e-7,
+        "error {error:e} against estimate {estimate:e}"
+    );
+    assert!(
+        estimate <= 30.0 * error + 1e-6,
+        "estimate {estimate:e} against error {error:e}"
+    );
+    assert_eq!(dense.is_stable(), reduced.is_stable());
+    assert!((dense.max_abs() - reduced.max_abs()).abs() <= error + 1e-12);
+}
+
+/// `max_i min_j |a_i - b_j|`.
+fn one_way(a: &[Complex64], b: &[Complex64]) -> f64 {
+    a.iter()
+        .map(|x| {
+            b.iter()
+                .map(|y| (x - y).norm())
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}

@@ -149,22 +149,21 @@ impl FloquetOptions {
     }
 }
 
-/// `max_i min_j |a_i - b_j|` over the leading `a_i` (modulus at least half the largest, at
-/// most 8); the difference of the largest moduli where `b` is empty.
+/// The larger of `max_i min_j |a_i - b_j|` over the leading `a_i` and the same over the
+/// leading `b_j`, leading meaning a modulus at least half the largest of both sets (at most 8
+/// from each): a multiplier that only one basis has counts with its distance to the other's
+/// nearest.
 fn distance(a: &[Complex64], b: &[Complex64]) -> f64 {
-    let top = a.first().map_or(0.0, |m| m.norm());
-    a.iter()
-        .take(8)
-        .filter(|m| m.norm() >= 0.5 * top)
-        .map(|m| {
-            b.iter()
-                .map(|o| (m - o).norm())
-                .fold(f64::INFINITY, f64::min)
-                .min(if b.is_empty() {
-                    m.norm()
-                } else {
-                    f64::INFINITY
-                })
-        })
-        .fold((top - b.first().map_or(0.0, |m| m.norm())).abs(), f64::max)
+    let top = a
+        .first()
+        .map_or(0.0, |m| m.norm())
+        .max(b.first().map_or(0.0, |m| m.norm()));
+    let one_way = |a: &[Complex64], b: &[Complex64]| {
+        a.iter()
+            .take(8)
+            .filter(|m| m.norm() >= 0.5 * top)
+            .map(|m| b.iter().map(|o| (m - o).norm()).fold(m.norm(), f64::min))
+            .fold(0.0, f64::max)
+    };
+    one_way(a, b).max(one_way(b, a))
 }

@@ -26,7 +26,7 @@
 use super::dopri::{hermite, step_factor, Stepper};
 use super::system::Coordinates;
 use crate::error::{Error, Result};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
 
 /// Where each element is relative to its kinks: `side[e] = j` means
 /// `kinks[e][j-1] <= u < kinks[e][j]` (open at the ends).
@@ -67,13 +67,11 @@ pub(crate) struct Flow<'c, 'm> {
     omega_s: f64,
     atol: Vec<f64>,
     /// `M⁻¹K/ω_s`, `M⁻¹D` (row-major) and `M⁻¹w_e` per element.
-    mk0: Vec<f64>,
-    md0: Vec<f64>,
+    base: Vec<f64>,
     mw: Vec<Vec<f64>>,
     // Buffers.
     load: Vec<f64>,
-    bk: Vec<f64>,
-    cd: Vec<f64>,
+    bc: Vec<f64>,
     /// `(t_b, cos Ωt_b, sin Ωt_b)`: the phasor at the current step start.
     phasor_base: (f64, f64, f64),
     /// The step size at the end of the last period (the next one starts with it).
@@ -132,8 +130,13 @@ impl<'c, 'm> Flow<'c, 'm> {
             scale_q,
             omega_s: scale_v / scale_q,
             atol,
-            mk0: row_major(&(&m_inv * &sys.stiffness / (scale_v / scale_q))),
-            md0: row_major(&(&m_inv * &sys.damping)),
+            base: {
+                let mut b = DMatrix::zeros(n, 2 * n);
+                b.columns_mut(0, n)
+                    .copy_from(&(&m_inv * &sys.stiffness / (scale_v / scale_q)));
+                b.columns_mut(n, n).copy_from(&(&m_inv * &sys.damping));
+                b.as_slice().to_vec()
+            },
             mw: sys
                 .weights
                 .iter()
@@ -144,8 +147,7 @@ impl<'c, 'm> Flow<'c, 'm> {
                 })
                 .collect(),
             load: vec![0.0; n],
-            bk: vec![0.0; n * n],
-            cd: vec![0.0; n * n],
+            bc: vec![0.0; 2 * n * n],
             h_last: 0.0,
             phasor_base: (0.0, 1.0, 0.0),
             steps: 0,
@@ -193,16 +195,18 @@ impl<'c, 'm> Flow<'c, 'm> {
         self.load.fill(0.0);
         let (c, s) = self.phasor(t);
         self.sys.load_into_phasor(c, s, &mut self.load);
-        self.bk.copy_from_slice(&self.mk0);
-        self.cd.copy_from_slice(&self.md0);
-        for i in 0..n {
-            let (mut s, row) = (0.0, i * n);
-            for j in 0..n {
-                s += self.m_inv[(i, j)] * self.load[j]
-                    - self.md0[row + j] * v[j]
-                    - self.mk0[row + j] * self.omega_s * q[j];
+        self.bc.copy_from_slice(&self.base);
+        // q̈ = M⁻¹ f - (M⁻¹D) q̇ - (M⁻¹K) q, column by column of the column-major base.
+        dv.fill(0.0);
+        for j in 0..n {
+            let (fj, vj, qj) = (self.load[j], v[j], self.omega_s * q[j]);
+            let (kc, dc) = (
+                &self.base[j * n..(j + 1) * n],
+                &self.base[(n + j) * n..(n + j + 1) * n],
+            );
+            for i in 0..n {
+                dv[i] += self.m_inv[(i, j)] * fj - dc[i] * vj - kc[i] * qj;
             }
-            dv[i] = s;
         }
         let sys = self.sys;
         for ei in 0..sys.weights.len() {
@@ -211,28 +215,34 @@ impl<'c, 'm> Flow<'c, 'm> {
             let ks = ke / self.omega_s;
             for i in 0..n {
                 dv[i] -= f * mw[i];
-                if ks != 0.0 || de != 0.0 {
-                    for &(j, wj) in &sys.weights[ei] {
-                        self.bk[i * n + j] += ks * mw[i] * wj;
-                        self.cd[i * n + j] += de * mw[i] * wj;
+            }
+            if ks != 0.0 || de != 0.0 {
+                for &(j, wj) in &sys.weights[ei] {
+                    let (kc, dc) = self.bc.split_at_mut((n + j) * n);
+                    let (kc, dc) = (&mut kc[j * n..(j + 1) * n], &mut dc[..n]);
+                    for i in 0..n {
+                        kc[i] += ks * mw[i] * wj;
+                        dc[i] += de * mw[i] * wj;
                     }
                 }
             }
         }
+        // Φ̃' = [[0, ω_s I], [-(M⁻¹K(t)/ω_s), -M⁻¹D(t)]] Φ̃: the lower block row by one
+        // matrix product `-[B C] Φ̃` (n × 2n times 2n × 2n).
         let s2 = 2 * n;
         for c in 0..s2 {
-            let col = &phi[c * s2..(c + 1) * s2];
-            let (top, bot) = col.split_at(n);
-            let out = &mut dphi[c * s2..(c + 1) * s2];
+            let (top, bot) = (
+                &mut dphi[c * s2..c * s2 + n],
+                &phi[c * s2 + n..(c + 1) * s2],
+            );
             for i in 0..n {
-                out[i] = self.omega_s * bot[i];
-                let (mut s, row) = (0.0, i * n);
-                for j in 0..n {
-                    s += self.bk[row + j] * top[j] + self.cd[row + j] * bot[j];
-                }
-                out[n + i] = -s;
+                top[i] = self.omega_s * bot[i];
             }
         }
+        let bc = DMatrixView::from_slice(&self.bc, n, s2);
+        let phi_m = DMatrixView::from_slice(phi, s2, s2);
+        let mut out = DMatrixViewMut::from_slice_with_strides_mut(&mut dphi[n..], n, s2, 1, s2);
+        out.gemm(-1.0, &bc, &phi_m, 0.0);
     }
 
     /// `(cos Ωt, sin Ωt)` from the phasor at the step start by a short Taylor series of
@@ -535,9 +545,4 @@ impl<'c, 'm> Flow<'c, 'm> {
 fn nudge(x: f64, direction: f64) -> f64 {
     let step = 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE);
     x + direction * step
-}
-
-/// The entries of `a` row by row.
-fn row_major(a: &DMatrix<f64>) -> Vec<f64> {
-    a.transpose().as_slice().to_vec()
 }

@@ -95,6 +95,9 @@ fn subspace_iteration(
     for _ in 0..200 {
         let mut y = super::system::sparse_times(m, &x);
         factor.solve_in_place(&mut y);
+        // Columns scaled by 1/(λ + σ) span a wide range (a free or softly grounded model):
+        // M-orthonormalise them in order before the Ritz step.
+        m_orthonormalise(m, &mut y, &mut random);
         let (values, z) = rayleigh_ritz(k0, m, &y)?;
         x = &y * z;
         let below = values.iter().filter(|&&v| v <= cutoff).count();
@@ -123,6 +126,47 @@ fn subspace_iteration(
     Err(Error::Solver {
         reason: "the subspace iteration for the lowest modes of (K0, M) did not converge in 200 iterations".into(),
     })
+}
+
+/// Gram–Schmidt in the M inner product, twice per column, in column order; a column that
+/// lies in the span of the previous ones is replaced by a fresh random one.
+fn m_orthonormalise(
+    m: &SparseMatrix,
+    y: &mut DMatrix<f64>,
+    random: &mut impl FnMut(usize, usize) -> DMatrix<f64>,
+) {
+    let n = y.nrows();
+    for j in 0..y.ncols() {
+        for attempt in 0..3 {
+            let mut x = y.column(j).into_owned();
+            let norm0 = m_norm(m, x.as_slice());
+            for _ in 0..2 {
+                let mut mx = vec![0.0; n];
+                m.mul_add(1.0, x.as_slice(), &mut mx);
+                for i in 0..j {
+                    let c: f64 = y.column(i).iter().zip(&mx).map(|(a, b)| a * b).sum();
+                    x.axpy(-c, &y.column(i), 1.0);
+                }
+            }
+            let norm = m_norm(m, x.as_slice());
+            if norm > 1e-10 * norm0 && norm.is_finite() && norm > 0.0 || attempt == 2 {
+                y.set_column(j, &(x / norm.max(f64::MIN_POSITIVE)));
+                break;
+            }
+            y.set_column(j, &random(n, 1).column(0));
+        }
+    }
+}
+
+fn m_norm(m: &SparseMatrix, x: &[f64]) -> f64 {
+    let mut mx = vec![0.0; x.len()];
+    m.mul_add(1.0, x, &mut mx);
+    x.iter()
+        .zip(&mx)
+        .map(|(a, b)| a * b)
+        .sum::<f64>()
+        .max(0.0)
+        .sqrt()
 }
 
 /// The Ritz pairs of `(k0, m)` on the columns of `y`: values ascending, `Z` with `YZ`
