@@ -85,7 +85,7 @@ impl FloquetOptions {
                 "in (1e-15, 1e-2)",
             ));
         }
-        if !(self.cutoff > 0.0) {
+        if self.cutoff.is_nan() || self.cutoff <= 0.0 {
             return Err(Error::invalid(
                 "floquet",
                 "cutoff",
