@@ -23,6 +23,15 @@
 //! symmetry-breaking branch point), through −1 a period doubling, a complex pair a
 //! Neimark–Sacker bifurcation.
 //!
+//! **Large models.** The dense `Φ` costs `O(n³)` per step. From
+//! [`FloquetMethod::REDUCED_FROM`] DOFs on (or with [`FloquetMethod::Reduced`]) the same
+//! shooting runs on the Galerkin projection onto `V` = the undamped modes of `(K0, M)` below
+//! `ω_c = cutoff · H Ω/ν` plus the static attachment modes of the element coordinates and
+//! loaded DOFs (sparse Cholesky of `K0 + σM`, shift-invert subspace iteration), with the
+//! model's own force laws on `u_e = (Vᵀw_e)·p`; [`Floquet::reduction`] records the basis and
+//! an accuracy estimate against the basis with twice the cut-off. With every mode kept the
+//! projection is a similarity transform and gives the dense multipliers.
+//!
 //! ```
 //! use hbal::force::CubicSpring;
 //! use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
