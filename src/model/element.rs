@@ -56,13 +56,4 @@ impl Element {
             out[i] += f * w;
         }
     }
-
-    /// `a += s w wᵀ`.
-    pub(crate) fn add_outer(&self, a: &mut nalgebra::DMatrix<f64>, s: f64) {
-        for &(i, wi) in &self.weights {
-            for &(j, wj) in &self.weights {
-                a[(i, j)] += s * wi * wj;
-            }
-        }
-    }
 }

@@ -24,9 +24,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::dopri::{hermite, step_factor, Stepper};
+use super::system::Coordinates;
 use crate::error::{Error, Result};
-use crate::model::Model;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
 
 /// Where each element is relative to its kinks: `side[e] = j` means
 /// `kinks[e][j-1] <= u < kinks[e][j]` (open at the ends).
@@ -53,8 +53,8 @@ pub(crate) struct FlowOptions {
 }
 
 /// The flow over one period.
-pub(crate) struct Flow<'m> {
-    model: &'m Model,
+pub(crate) struct Flow<'c, 'm> {
+    sys: &'c Coordinates<'m>,
     n: usize,
     m_inv: DMatrix<f64>,
     omega: f64,
@@ -67,13 +67,11 @@ pub(crate) struct Flow<'m> {
     omega_s: f64,
     atol: Vec<f64>,
     /// `M⁻¹K/ω_s`, `M⁻¹D` (row-major) and `M⁻¹w_e` per element.
-    mk0: Vec<f64>,
-    md0: Vec<f64>,
+    base: Vec<f64>,
     mw: Vec<Vec<f64>>,
     // Buffers.
     load: Vec<f64>,
-    bk: Vec<f64>,
-    cd: Vec<f64>,
+    bc: Vec<f64>,
     /// `(t_b, cos Ωt_b, sin Ωt_b)`: the phasor at the current step start.
     phasor_base: (f64, f64, f64),
     /// The step size at the end of the last period (the next one starts with it).
@@ -82,19 +80,20 @@ pub(crate) struct Flow<'m> {
     pub steps: usize,
 }
 
-impl<'m> Flow<'m> {
-    /// The flow of `model` at fundamental `omega`, with state scales `s_q`, `s_v`.
+impl<'c, 'm> Flow<'c, 'm> {
+    /// The flow in the coordinates `sys` at fundamental `omega`, with state scales `s_q`, `s_v`.
     pub(crate) fn new(
-        model: &'m Model,
+        sys: &'c Coordinates<'m>,
         omega: f64,
         scale_q: f64,
         scale_v: f64,
         rtol: f64,
     ) -> Result<Self> {
-        let n = model.n_dofs();
-        let m_inv = model
-            .mass()
-            .to_dense()
+        let model = sys.model;
+        let n = sys.len();
+        let m_inv = sys
+            .mass
+            .clone()
             .cholesky()
             .ok_or_else(|| Error::MassNotPositiveDefinite {
                 reason: "Cholesky factorisation failed".into(),
@@ -121,7 +120,7 @@ impl<'m> Flow<'m> {
         atol[..n].iter_mut().for_each(|a| *a = rtol * scale_q);
         atol[n..2 * n].iter_mut().for_each(|a| *a = rtol * scale_v);
         Ok(Self {
-            model,
+            sys,
             n,
             m_inv: m_inv.clone(),
             omega,
@@ -131,22 +130,24 @@ impl<'m> Flow<'m> {
             scale_q,
             omega_s: scale_v / scale_q,
             atol,
-            mk0: row_major(
-                &(&m_inv * model.structural_stiffness().to_dense() / (scale_v / scale_q)),
-            ),
-            md0: row_major(&(&m_inv * model.structural_damping().to_dense())),
-            mw: model
-                .elements()
+            base: {
+                let mut b = DMatrix::zeros(n, 2 * n);
+                b.columns_mut(0, n)
+                    .copy_from(&(&m_inv * &sys.stiffness / (scale_v / scale_q)));
+                b.columns_mut(n, n).copy_from(&(&m_inv * &sys.damping));
+                b.as_slice().to_vec()
+            },
+            mw: sys
+                .weights
                 .iter()
-                .map(|e| {
+                .map(|w| {
                     (0..n)
-                        .map(|i| e.weights().iter().map(|&(j, wj)| m_inv[(i, j)] * wj).sum())
+                        .map(|i| w.iter().map(|&(j, wj)| m_inv[(i, j)] * wj).sum())
                         .collect()
                 })
                 .collect(),
             load: vec![0.0; n],
-            bk: vec![0.0; n * n],
-            cd: vec![0.0; n * n],
+            bc: vec![0.0; 2 * n * n],
             h_last: 0.0,
             phasor_base: (0.0, 1.0, 0.0),
             steps: 0,
@@ -165,7 +166,7 @@ impl<'m> Flow<'m> {
 
     /// Force and derivatives of element `e` on its current piece at `(θ, u, u̇)`.
     fn element_law(&self, e: usize, theta: f64, u: f64, du: f64) -> (f64, f64, f64) {
-        let law = self.model.elements()[e].law();
+        let law = self.sys.model.elements()[e].law();
         let (lo, hi) = self.pieces.interval(e);
         if u > lo && u < hi {
             let f = law.force(theta, u, du);
@@ -193,46 +194,55 @@ impl<'m> Flow<'m> {
         dq.copy_from_slice(v);
         self.load.fill(0.0);
         let (c, s) = self.phasor(t);
-        self.model.load_into_phasor(c, s, &mut self.load);
-        self.bk.copy_from_slice(&self.mk0);
-        self.cd.copy_from_slice(&self.md0);
-        for i in 0..n {
-            let (mut s, row) = (0.0, i * n);
-            for j in 0..n {
-                s += self.m_inv[(i, j)] * self.load[j]
-                    - self.md0[row + j] * v[j]
-                    - self.mk0[row + j] * self.omega_s * q[j];
+        self.sys.load_into_phasor(c, s, &mut self.load);
+        self.bc.copy_from_slice(&self.base);
+        // q̈ = M⁻¹ f - (M⁻¹D) q̇ - (M⁻¹K) q, column by column of the column-major base.
+        dv.fill(0.0);
+        for j in 0..n {
+            let (fj, vj, qj) = (self.load[j], v[j], self.omega_s * q[j]);
+            let (kc, dc) = (
+                &self.base[j * n..(j + 1) * n],
+                &self.base[(n + j) * n..(n + j + 1) * n],
+            );
+            for i in 0..n {
+                dv[i] += self.m_inv[(i, j)] * fj - dc[i] * vj - kc[i] * qj;
             }
-            dv[i] = s;
         }
-        for (ei, e) in self.model.elements().iter().enumerate() {
-            let (f, ke, de) = self.element_law(ei, theta, e.gather(q), e.gather(v));
+        let sys = self.sys;
+        for ei in 0..sys.weights.len() {
+            let (f, ke, de) = self.element_law(ei, theta, sys.gather(ei, q), sys.gather(ei, v));
             let mw = &self.mw[ei];
             let ks = ke / self.omega_s;
             for i in 0..n {
                 dv[i] -= f * mw[i];
-                if ks != 0.0 || de != 0.0 {
-                    for &(j, wj) in e.weights() {
-                        self.bk[i * n + j] += ks * mw[i] * wj;
-                        self.cd[i * n + j] += de * mw[i] * wj;
+            }
+            if ks != 0.0 || de != 0.0 {
+                for &(j, wj) in &sys.weights[ei] {
+                    let (kc, dc) = self.bc.split_at_mut((n + j) * n);
+                    let (kc, dc) = (&mut kc[j * n..(j + 1) * n], &mut dc[..n]);
+                    for i in 0..n {
+                        kc[i] += ks * mw[i] * wj;
+                        dc[i] += de * mw[i] * wj;
                     }
                 }
             }
         }
+        // Φ̃' = [[0, ω_s I], [-(M⁻¹K(t)/ω_s), -M⁻¹D(t)]] Φ̃: the lower block row by one
+        // matrix product `-[B C] Φ̃` (n × 2n times 2n × 2n).
         let s2 = 2 * n;
         for c in 0..s2 {
-            let col = &phi[c * s2..(c + 1) * s2];
-            let (top, bot) = col.split_at(n);
-            let out = &mut dphi[c * s2..(c + 1) * s2];
+            let (top, bot) = (
+                &mut dphi[c * s2..c * s2 + n],
+                &phi[c * s2 + n..(c + 1) * s2],
+            );
             for i in 0..n {
-                out[i] = self.omega_s * bot[i];
-                let (mut s, row) = (0.0, i * n);
-                for j in 0..n {
-                    s += self.bk[row + j] * top[j] + self.cd[row + j] * bot[j];
-                }
-                out[n + i] = -s;
+                top[i] = self.omega_s * bot[i];
             }
         }
+        let bc = DMatrixView::from_slice(&self.bc, n, s2);
+        let phi_m = DMatrixView::from_slice(phi, s2, s2);
+        let mut out = DMatrixViewMut::from_slice_with_strides_mut(&mut dphi[n..], n, s2, 1, s2);
+        out.gemm(-1.0, &bc, &phi_m, 0.0);
     }
 
     /// `(cos Ωt, sin Ωt)` from the phasor at the step start by a short Taylor series of
@@ -283,8 +293,11 @@ impl<'m> Flow<'m> {
     /// Sets each element's piece from the state `(q, q̇)` at the start.
     fn init_pieces(&mut self, y: &[f64]) {
         let n = self.n;
-        for (ei, e) in self.model.elements().iter().enumerate() {
-            let (u, du) = (e.gather(&y[..n]), e.gather(&y[n..2 * n]));
+        for ei in 0..self.sys.weights.len() {
+            let (u, du) = (
+                self.sys.gather(ei, &y[..n]),
+                self.sys.gather(ei, &y[n..2 * n]),
+            );
             let k = &self.pieces.kinks[ei];
             // On a kink, the side it is moving to.
             self.pieces.side[ei] = k
@@ -306,13 +319,13 @@ impl<'m> Flow<'m> {
     ) -> Option<(f64, usize, bool)> {
         let n = self.n;
         let mut best: Option<(f64, usize, bool)> = None;
-        for (ei, e) in self.model.elements().iter().enumerate() {
+        for ei in 0..self.sys.weights.len() {
             let (lo, hi) = self.pieces.interval(ei);
             if lo == f64::NEG_INFINITY && hi == f64::INFINITY {
                 continue;
             }
-            let (u0, u1) = (e.gather(&y[..n]), e.gather(&y1[..n]));
-            let (du0, du1) = (e.gather(&f0[..n]), e.gather(&f1[..n]));
+            let g = |x: &[f64]| self.sys.gather(ei, &x[..n]);
+            let (u0, u1, du0, du1) = (g(y), g(y1), g(f0), g(f1));
             let tol = 1e-13 * (self.scale_q + lo.abs().min(hi.abs()).min(1e300));
             let outside = |u: f64| -> Option<bool> {
                 if u >= hi + tol {
@@ -455,7 +468,7 @@ impl<'m> Flow<'m> {
                         lo
                     }
                 };
-                let el = &self.model.elements()[e];
+                let sys = self.sys;
                 let mut hc = s * hs;
                 ytmp.copy_from_slice(y);
                 stepper.start_derivative().copy_from_slice(&f0);
@@ -469,8 +482,8 @@ impl<'m> Flow<'m> {
                         opts.rtol,
                         atol,
                     );
-                    let u = el.gather(&stepper.y_new[..n]);
-                    let du = el.gather(&stepper.y_new[n..2 * n]);
+                    let u = sys.gather(e, &stepper.y_new[..n]);
+                    let du = sys.gather(e, &stepper.y_new[n..2 * n]);
                     let g = u - edge;
                     if g.abs() <= 1e-14 * (edge.abs() + self.scale_q) || du == 0.0 {
                         break;
@@ -494,8 +507,8 @@ impl<'m> Flow<'m> {
         let n = self.n;
         let (ta, tha, lo, hi) = self.segment;
         let theta = (tha + self.omega * (t - ta)).clamp(lo, hi);
-        let el = &self.model.elements()[e];
-        let (u, du) = (el.gather(&y[..n]), el.gather(&y[n..2 * n]));
+        let sys = self.sys;
+        let (u, du) = (sys.gather(e, &y[..n]), sys.gather(e, &y[n..2 * n]));
         let (f_before, _, _) = self.element_law(e, theta, u, du);
         if up {
             self.pieces.side[e] += 1;
@@ -511,8 +524,7 @@ impl<'m> Flow<'m> {
         // δq̇ += -M⁻¹ w Δf (wᵀ δq) / u̇, in the scaled coordinates.
         let mut mw = vec![0.0; n];
         for i in 0..n {
-            mw[i] = el
-                .weights()
+            mw[i] = sys.weights[e]
                 .iter()
                 .map(|&(j, wj)| self.m_inv[(i, j)] * wj)
                 .sum();
@@ -521,7 +533,7 @@ impl<'m> Flow<'m> {
         let s2 = 2 * n;
         for c in 0..s2 {
             let col = &mut y[s2 + c * s2..s2 + (c + 1) * s2];
-            let wq = el.gather(&col[..n]);
+            let wq = sys.gather(e, &col[..n]);
             for i in 0..n {
                 col[n + i] += factor * mw[i] * wq;
             }
@@ -533,9 +545,4 @@ impl<'m> Flow<'m> {
 fn nudge(x: f64, direction: f64) -> f64 {
     let step = 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE);
     x + direction * step
-}
-
-/// The entries of `a` row by row.
-fn row_major(a: &DMatrix<f64>) -> Vec<f64> {
-    a.transpose().as_slice().to_vec()
 }

@@ -7,12 +7,20 @@
 //! stability. In an orthonormal basis `[V W]` the monodromy matrix is block upper triangular,
 //! and the multipliers that decide stability are those of `Wᵀ Φ W`.
 
-use crate::model::Model;
+use super::system::Coordinates;
 use nalgebra::DMatrix;
 
-/// Orthonormal basis (columns) of the rigid-body modes of `model`, in the DOF coordinates.
-pub(crate) fn rigid_body_modes(model: &Model) -> DMatrix<f64> {
-    let n = model.n_dofs();
+/// Orthonormal basis (columns) of the rigid-body modes in the coordinates `sys`.
+pub(crate) fn rigid_body_modes(sys: &Coordinates) -> DMatrix<f64> {
+    match &sys.basis {
+        None => in_dofs(sys),
+        Some(v) => on_basis(sys, v),
+    }
+}
+
+/// The rigid-body modes in the model's DOFs.
+fn in_dofs(sys: &Coordinates) -> DMatrix<f64> {
+    let n = sys.len();
     // G = [K/|K|; D/|D|; w_eᵀ/|w_e|]; its null space is the set of free motions.
     let mut g = DMatrix::<f64>::zeros(n, n);
     let mut add_rows = |rows: &DMatrix<f64>| {
@@ -21,11 +29,11 @@ pub(crate) fn rigid_body_modes(model: &Model) -> DMatrix<f64> {
             g += rows.transpose() * rows / (norm * norm);
         }
     };
-    add_rows(&model.structural_stiffness().to_dense());
-    add_rows(&model.structural_damping().to_dense());
-    for e in model.elements() {
+    add_rows(&sys.stiffness);
+    add_rows(&sys.damping);
+    for weights in &sys.weights {
         let mut w = DMatrix::<f64>::zeros(1, n);
-        for &(i, wi) in e.weights() {
+        for &(i, wi) in weights {
             w[(0, i)] += wi;
         }
         add_rows(&w);
@@ -40,6 +48,54 @@ pub(crate) fn rigid_body_modes(model: &Model) -> DMatrix<f64> {
         r.set_column(c, &eig.eigenvectors.column(i));
     }
     r
+}
+
+/// The rigid-body modes of the model inside the span of the basis `V`, by the same test as in
+/// the model's DOFs and independent of the basis's scaling: the null space of the pencil
+/// `(Vᵀ G V, VᵀV)`, whose eigenvalues are the Rayleigh quotients `xᵀGx / xᵀx` of
+/// `x = V p` with `G` built in the model's DOFs. Orthonormal in the reduced coordinates.
+fn on_basis(sys: &Coordinates, v: &DMatrix<f64>) -> DMatrix<f64> {
+    let model = sys.model;
+    let r = v.ncols();
+    let mut g = DMatrix::<f64>::zeros(r, r);
+    let mut add_rows = |rows: &DMatrix<f64>, norm: f64| {
+        if norm > 0.0 {
+            g += rows.transpose() * rows / (norm * norm);
+        }
+    };
+    for a in [model.structural_stiffness(), model.structural_damping()] {
+        add_rows(&super::system::sparse_times(a, v), a.amax());
+    }
+    for e in model.elements() {
+        let w = DMatrix::from_fn(1, r, |_, j| {
+            e.weights().iter().map(|&(i, wi)| wi * v[(i, j)]).sum()
+        });
+        let norm = e
+            .weights()
+            .iter()
+            .fold(0.0_f64, |m, &(_, w)| m.max(w.abs()));
+        add_rows(&w, norm);
+    }
+    let Some(chol) = (v.transpose() * v).cholesky() else {
+        return DMatrix::zeros(r, 0);
+    };
+    let Some(l_inv) = chol.l().try_inverse() else {
+        return DMatrix::zeros(r, 0);
+    };
+    let a = &l_inv * g * l_inv.transpose();
+    let eig = ((&a + a.transpose()) * 0.5).symmetric_eigen();
+    let top = eig.eigenvalues.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let free: Vec<usize> = (0..r)
+        .filter(|&i| eig.eigenvalues[i].abs() <= 1e-12 * top.max(f64::MIN_POSITIVE))
+        .collect();
+    if free.is_empty() {
+        return DMatrix::zeros(r, 0);
+    }
+    let mut y = DMatrix::zeros(r, free.len());
+    for (c, &i) in free.iter().enumerate() {
+        y.set_column(c, &(l_inv.transpose() * eig.eigenvectors.column(i)));
+    }
+    y.qr().q()
 }
 
 /// An orthonormal basis of the orthogonal complement of the columns of `v` (orthonormal) in
@@ -78,6 +134,7 @@ pub(crate) fn state_bases(r: &DMatrix<f64>) -> (DMatrix<f64>, DMatrix<f64>) {
 mod tests {
     use super::*;
     use crate::force::LinearSpring;
+    use crate::model::Model;
 
     #[test]
     fn two_inertias_on_a_shaft_have_one_rigid_mode() {
@@ -90,7 +147,7 @@ mod tests {
             )
             .build()
             .unwrap();
-        let r = rigid_body_modes(&model);
+        let r = rigid_body_modes(&Coordinates::full(&model));
         assert_eq!(r.ncols(), 1);
         assert!((r[(0, 0)] - r[(1, 0)]).abs() < 1e-12);
         let grounded = Model::builder(&["a", "b"])
@@ -103,7 +160,7 @@ mod tests {
             .element("ground", &[("a", 1.0)], LinearSpring::new(1e-9, 0.0))
             .build()
             .unwrap();
-        assert_eq!(rigid_body_modes(&grounded).ncols(), 0);
+        assert_eq!(rigid_body_modes(&Coordinates::full(&grounded)).ncols(), 0);
         let w = complement(&r, 2);
         assert_eq!(w.ncols(), 1);
         assert!((w.column(0).dot(&r.column(0))).abs() < 1e-12);
