@@ -123,6 +123,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 "orbit_correction": f.orbit_correction,
                 "polished": f.polished,
                 "seconds": stability_seconds,
+                "reduction": f.reduction,
             }),
             Some(Err(e)) => json!({ "error": e }),
         };
@@ -217,6 +218,25 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             ),
             Some(Err(e)) => say!("  stability: failed: {e}"),
         }
+        if let Some(Ok(Floquet {
+            reduction: Some(r), ..
+        })) = &stability
+        {
+            let estimate = match r.estimate {
+                Some(e) => format!(
+                    ", multipliers to about {e:.1e} (against {} coordinates)",
+                    r.comparison_dofs.unwrap_or(0)
+                ),
+                None => String::new(),
+            };
+            say!(
+                "  stability on a reduced basis: {} coordinates ({} modes below {:.0} rad/s, {} attachment modes){estimate}",
+                r.dofs,
+                r.modes,
+                r.cutoff,
+                r.attachment
+            );
+        }
     }
     match &stability {
         Some(Ok(f)) if !f.is_stable() => eprintln!(
@@ -287,10 +307,11 @@ fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
         csv.push('\n');
     }
     std::fs::write(dir.join("time_series.csv"), csv)?;
-    let lines: Vec<Series> = sol
-        .dof_names()
+    let (shown, note) = plotted_dofs(sol, h);
+    let names = sol.dof_names();
+    let lines: Vec<Series> = shown
         .iter()
-        .zip(&series)
+        .map(|&i| (&names[i], &series[i]))
         .map(|(name, s)| {
             Series::line(
                 name.clone(),
@@ -303,16 +324,15 @@ fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
         .collect();
     line_plot(
         &dir.join("time_series.svg"),
-        "Periodic solution over one period",
+        &format!("Periodic solution over one period{note}"),
         &Axis::linear("t (s)"),
         &Axis::linear("q"),
         &lines,
     )
     .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
-    let spectra: Vec<Series> = sol
-        .dof_names()
+    let spectra: Vec<Series> = shown
         .iter()
-        .enumerate()
+        .map(|&i| (i, &names[i]))
         .map(|(i, name)| {
             Series::markers(
                 name.clone(),
@@ -325,7 +345,7 @@ fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
     if h > 0 {
         line_plot(
             &dir.join("spectrum.svg"),
-            "Amplitude spectrum (static part omitted)",
+            &format!("Amplitude spectrum (static part omitted){note}"),
             &Axis::linear("harmonic order"),
             &Axis::log("amplitude"),
             &spectra,
@@ -333,4 +353,25 @@ fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
     }
     Ok(())
+}
+
+/// Most DOFs a plot shows (a legend of a thousand names hides the data).
+const MAX_PLOTTED_DOFS: usize = 8;
+
+/// The DOFs the plots show: all of a small model, else the [`MAX_PLOTTED_DOFS`] with the
+/// largest dynamic amplitude `Σ_{k≥1} |q̂_k|`, in model order, and a note for the title.
+fn plotted_dofs(sol: &hbal::Solution, h: usize) -> (Vec<usize>, String) {
+    let n = sol.dof_names().len();
+    if n <= MAX_PLOTTED_DOFS {
+        return ((0..n).collect(), String::new());
+    }
+    let amplitude = |i: usize| (1..=h).map(|k| sol.harmonic(i, k).norm()).sum::<f64>();
+    let mut order: Vec<(usize, f64)> = (0..n).map(|i| (i, amplitude(i))).collect();
+    order.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let mut shown: Vec<usize> = order.iter().take(MAX_PLOTTED_DOFS).map(|p| p.0).collect();
+    shown.sort_unstable();
+    (
+        shown,
+        format!(" ({MAX_PLOTTED_DOFS} of {n} DOFs: the largest dynamic amplitudes)"),
+    )
 }

@@ -132,7 +132,11 @@ pub fn line_plot(
     let (x0, x1) = pad(x0, x1, x.log);
     let (y0, mut y1) = pad(y0, y1, y.log);
     // Head room for the legend (upper right) so it does not cover the curves.
-    let rows = series.len() as f64;
+    let rows = series
+        .iter()
+        .filter(|s| !s.label.is_empty())
+        .count()
+        .min(12) as f64;
     if y.log {
         y1 *= 10f64.powf(0.12 * rows * (y1 / y0).log10().max(1.0) / 4.0);
     } else {

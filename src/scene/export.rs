@@ -116,9 +116,8 @@ pub fn write_scene(model: &Model, settings: &SceneSettings, path: &Path) -> Resu
             continue;
         }
         let target = dir.join(format!("{what}.mtx"));
-        let mut out = std::io::BufWriter::new(
-            std::fs::File::create(&target).map_err(|e| fail(&target, &e))?,
-        );
+        let mut out =
+            std::io::BufWriter::new(std::fs::File::create(&target).map_err(|e| fail(&target, &e))?);
         let comment = format!("{what} matrix of {} ({} DOFs, SI units)", stem, a.n());
         matrix_market::write(&mut out, a, &comment).map_err(|e| fail(&target, &e))?;
         std::io::Write::flush(&mut out).map_err(|e| fail(&target, &e))?;
@@ -172,7 +171,8 @@ pub fn write_scene(model: &Model, settings: &SceneSettings, path: &Path) -> Resu
     }
     doc.insert("elements".into(), Value::Array(elements));
     let text = toml::to_string(&Value::Object(doc)).map_err(|e| fail(path, &e))?;
-    let header = "# Written by hbal (scene::export): the model's matrices and DOF names are in the\n\
+    let header =
+        "# Written by hbal (scene::export): the model's matrices and DOF names are in the\n\
                   # directory next to this file.\n";
     std::fs::write(path, format!("{header}{text}")).map_err(|e| fail(path, &e))
 }
