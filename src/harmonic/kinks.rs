@@ -65,19 +65,35 @@ const BERNOULLI: [f64; ORDERS + 1] = [
     0.0,
 ];
 
-/// Binomial coefficients `C(n, k)` for `n <= ORDERS`.
+/// Pascal's triangle: `BINOMIAL[n][k] = C(n, k)` for `n <= ORDERS`.
+const BINOMIAL: [[f64; ORDERS + 1]; ORDERS + 1] = {
+    let mut t = [[0.0; ORDERS + 1]; ORDERS + 1];
+    let mut n = 0;
+    while n <= ORDERS {
+        t[n][0] = 1.0;
+        let mut k = 1;
+        while k <= n {
+            t[n][k] = t[n - 1][k - 1] + if k < n { t[n - 1][k] } else { 0.0 };
+            k += 1;
+        }
+        n += 1;
+    }
+    t
+};
+
+/// `C(n, k)` for `n <= ORDERS`.
 fn binomial(n: usize, k: usize) -> f64 {
-    (0..k).fold(1.0, |c, i| c * (n - i) as f64 / (i + 1) as f64)
+    BINOMIAL[n][k]
 }
 
-/// The Bernoulli polynomials `B_1(a) ..= B_ORDERS(a)` (index m holds `B_{m+1}`).
+/// The Bernoulli polynomials `B_1(a) ..= B_ORDERS(a)` (index m holds `B_{m+1}`), each
+/// `B_n(a) = Σ_k C(n, k) B_k a^{n-k}` by Horner's rule in `a`.
 fn bernoulli_polynomials(a: f64) -> [f64; ORDERS] {
     let mut out = [0.0; ORDERS];
     for (m, o) in out.iter_mut().enumerate() {
         let n = m + 1;
-        *o = (0..=n)
-            .map(|k| binomial(n, k) * BERNOULLI[k] * a.powi((n - k) as i32))
-            .sum();
+        // Highest power first: a^n has k = 0.
+        *o = (0..=n).fold(0.0, |acc, k| acc * a + BINOMIAL[n][k] * BERNOULLI[k]);
     }
     out
 }
@@ -156,15 +172,27 @@ fn correct(
             }
         }
     }
+    // z = -ik is imaginary: z^{2j} = (-1)^j k^{2j}, z^{2j+1} = -i (-1)^j k^{2j+1}, so the
+    // polynomial is `P(k²) + i k Q(k²)` with real `P`, `Q` (Horner in real arithmetic).
+    const EVEN: usize = ORDERS.div_ceil(2);
+    let mut even = [0.0; EVEN];
+    let mut odd = [0.0; ORDERS / 2];
+    for (p, cp) in coef.iter().enumerate() {
+        let sign = if (p / 2) % 2 == 0 { 1.0 } else { -1.0 };
+        if p % 2 == 0 {
+            even[p / 2] = sign * cp;
+        } else {
+            odd[p / 2] = -sign * cp;
+        }
+    }
     let step = Complex64::from_polar(1.0, -theta);
     let mut e = Complex64::new(1.0, 0.0);
     for (k, xk) in x.iter_mut().enumerate() {
-        let z = Complex64::new(0.0, -(k as f64));
-        let err = coef
-            .iter()
-            .rev()
-            .fold(Complex64::default(), |acc, cp| acc * z + cp);
-        *xk -= err * e * scale(k);
+        let kf = k as f64;
+        let k2 = kf * kf;
+        let re = even.iter().rev().fold(0.0, |acc, c| acc * k2 + c);
+        let im = kf * odd.iter().rev().fold(0.0, |acc, c| acc * k2 + c);
+        *xk -= Complex64::new(re, im) * e * scale(k);
         e *= step;
     }
 }
