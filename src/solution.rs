@@ -254,8 +254,55 @@ impl Solution {
     /// (within one sample spacing), so exact to rounding instead of to the sampling's
     /// `O((π/4N)²)`.
     pub fn extremes(&self, dof: usize) -> (f64, f64) {
-        let points = (4 * self.basis.samples()).max(64);
+        let points = self.extreme_points();
         let series = self.time_series(dof, points);
+        self.extremes_of(dof, &series)
+    }
+
+    /// [`Solution::extremes`] of every DOF, with one FFT plan for all (a large model's sweep
+    /// point: planning per DOF cost more than the transforms).
+    pub fn extremes_all(&self) -> Vec<(f64, f64)> {
+        let n = self.dofs.len();
+        let h = self.basis.harmonics();
+        let points = self.extreme_points();
+        let plan = HarmonicBasis::new(self.basis.omega(), h)
+            .and_then(|b| b.with_samples(points))
+            .ok()
+            .filter(|_| n > 1 && points > 2 * h)
+            .map(crate::harmonic::AftPlan::new);
+        let Some(plan) = plan else {
+            return (0..n).map(|i| self.extremes(i)).collect();
+        };
+        let mut scratch = plan.make_scratch();
+        let mut q = vec![Complex64::default(); h + 1];
+        let mut series = vec![0.0; points];
+        (0..n)
+            .map(|dof| {
+                for (k, qk) in q.iter_mut().enumerate() {
+                    *qk = self.harmonics[k * n + dof];
+                }
+                plan.synthesize_into(&q, |_| Complex64::new(1.0, 0.0), &mut series, &mut scratch);
+                self.extremes_of(dof, &series)
+            })
+            .collect()
+    }
+
+    /// `max |q_i|` of every DOF (see [`Solution::extremes_all`]).
+    pub fn max_abs_all(&self) -> Vec<f64> {
+        self.extremes_all()
+            .into_iter()
+            .map(|(lo, hi)| lo.abs().max(hi.abs()))
+            .collect()
+    }
+
+    /// Samples the extremes are searched on: 4N, at least 64.
+    fn extreme_points(&self) -> usize {
+        (4 * self.basis.samples()).max(64)
+    }
+
+    /// The refined extremes of `dof` from its samples `series` over one period.
+    fn extremes_of(&self, dof: usize, series: &[f64]) -> (f64, f64) {
+        let points = series.len();
         let step = std::f64::consts::TAU / points as f64;
         let (mut imin, mut imax) = (0, 0);
         for (j, v) in series.iter().enumerate() {
@@ -278,8 +325,14 @@ impl Solution {
         let h = self.basis.harmonics();
         let derivs = |t: f64| {
             let (mut q, mut d1, mut d2) = (0.0, 0.0, 0.0);
+            // e^{ikt} by the recurrence e^{it} e^{i(k-1)t}: one sine and cosine per call.
+            let step = Complex64::from_polar(1.0, t);
+            let mut rot = Complex64::new(1.0, 0.0);
             for k in 0..=h {
-                let z = self.harmonic(dof, k) * Complex64::from_polar(1.0, k as f64 * t);
+                if k > 0 {
+                    rot *= step;
+                }
+                let z = self.harmonic(dof, k) * rot;
                 let kf = k as f64;
                 q += z.re;
                 d1 -= kf * z.im;
@@ -333,5 +386,37 @@ impl Solution {
         } else {
             (tail / all).sqrt()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One FFT plan for all DOFs gives the per-DOF extremes, and both find the analytic
+    /// extremes of `q = a cos(θ - φ) + b cos(40 θ)` between the samples.
+    #[test]
+    fn extremes_of_all_dofs_equal_the_per_dof_extremes() {
+        let (n, h) = (3, 40);
+        let mut q = vec![Complex64::default(); (h + 1) * n];
+        for dof in 0..n {
+            let a = 1.0 + dof as f64;
+            q[n + dof] = Complex64::from_polar(a, -0.3 * dof as f64 - 0.1234);
+            q[h * n + dof] = Complex64::new(1e-3, 0.0);
+            q[dof] = Complex64::new(0.5 * dof as f64, 0.0);
+        }
+        let basis = HarmonicBasis::new(2.0, h).unwrap();
+        let names = (0..n).map(|i| format!("x{i}")).collect();
+        let sol = Solution::from_harmonics(basis, names, q, 0.0).unwrap();
+        let all = sol.extremes_all();
+        for (dof, &(lo, hi)) in all.iter().enumerate() {
+            let (l, u) = sol.extremes(dof);
+            assert!((lo - l).abs() < 1e-13 && (hi - u).abs() < 1e-13, "{dof}");
+            // The small 40th harmonic moves the extremes of mean ± a by at most its amplitude.
+            let (mean, a) = (0.5 * dof as f64, 1.0 + dof as f64);
+            assert!((hi - (mean + a)).abs() <= 1e-3 + 1e-12, "{dof}: {hi}");
+            assert!((lo - (mean - a)).abs() <= 1e-3 + 1e-12, "{dof}: {lo}");
+        }
+        assert_eq!(sol.max_abs_all()[2], sol.max_abs(2));
     }
 }

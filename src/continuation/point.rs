@@ -65,7 +65,7 @@ impl Continuation {
             (Some(false), Some(true)) => prev.as_ref().and_then(|f| f.critical()),
             _ => None,
         };
-        let max_abs = (0..model.n_dofs()).map(|i| sol.max_abs(i)).collect();
+        let max_abs = sol.max_abs_all();
         let truncation = sol.truncation_estimate();
         let error_estimate = self
             .error_estimate

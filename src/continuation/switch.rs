@@ -139,7 +139,7 @@ impl Continuation {
             q_star.clone(),
             0.0,
         )
-        .map(|s| (0..model.n_dofs()).map(|i| s.max_abs(i)).collect())
+        .map(|s| s.max_abs_all())
         .unwrap_or_default();
         let mut tr = Tracer::new(hb, Scales::new(0.0, o_star, 1.0));
         tr.sc = Scales::new(tr.rms(&x_star), o_star, tr.load_norm());
