@@ -271,3 +271,45 @@ fn cli_formulation_switch() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("expected `full`, `condensed` or `auto`"));
 }
+
+/// A parameter sweep (the mesh's load amplitude here: the engine torque's first order) in the
+/// condensed formulation gives the full formulation's points to 1e-10, all DOFs.
+#[test]
+fn condensed_parameter_sweep_equals_full() {
+    let basis = HarmonicBasis::new(300.0, 12).unwrap();
+    let build = |p: f64| {
+        // The chain with its engine torque scaled by p (loads add up on a DOF).
+        let model = chain();
+        let names: Vec<&str> = model.dof_names().iter().map(String::as_str).collect();
+        let mut builder = Model::builder(&names)
+            .mass(model.mass().to_dense())
+            .stiffness(model.structural_stiffness().to_dense())
+            .damping(model.structural_damping().to_dense());
+        for e in model.elements() {
+            let w: Vec<(&str, f64)> = e.weights().iter().map(|&(i, w)| (names[i], w)).collect();
+            let law: Box<dyn hbal::force::ForceLaw> =
+                serde_json::from_value(serde_json::to_value(e.law()).unwrap()).unwrap();
+            builder = builder.element_boxed(e.name(), &w, law);
+        }
+        for l in model.loads() {
+            let s = if l.order == 1 { p } else { 1.0 };
+            builder = builder.load(names[l.dof], l.order, s * l.cos, s * l.sin);
+        }
+        Ok((builder.build()?, basis))
+    };
+    let values = [0.5, 0.75, 1.0, 1.25];
+    let sweep = |formulation| {
+        hbal::continuation::parameter_sweep(&values, build, None, formulation, |_| {}).unwrap()
+    };
+    let (full, cond) = (sweep(Formulation::Full), sweep(Formulation::Condensed));
+    assert_eq!(full.points.len(), 4);
+    assert_eq!(cond.points.len(), 4);
+    for (a, b) in full.points.iter().zip(&cond.points) {
+        let d = relative_error(&b.harmonics, &a.harmonics, 7, 12);
+        assert!(d < 1e-10, "at p = {}: {d:.1e}", a.parameter);
+    }
+    // The points differ: the engine's first harmonic grows with its load (2.5 times the load).
+    let first = |k: usize| full.points[k].harmonics[7].norm();
+    let ratio = first(3) / first(0);
+    assert!(ratio > 1.5 && ratio < 4.0, "{ratio}");
+}

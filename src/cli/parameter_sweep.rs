@@ -83,6 +83,7 @@ pub(crate) fn parameter_sweep(
         },
         opts.stability
             .then(hbal::stability::FloquetOptions::default),
+        opts.solver.formulation,
         |f| bar.set_position((f * points as f64) as u64),
     )
     .map_err(|e| Failure {

@@ -7,22 +7,25 @@ use crate::model::Model;
 use crate::residual::HarmonicBalance;
 use crate::solve::{robust_start, Newton};
 use crate::stability::FloquetOptions;
-use crate::HarmonicBasis;
+use crate::{Formulation, HarmonicBasis};
 use num_complex::Complex64;
 
 /// A warm-started sweep over any parameter: `build(p)` gives the model and basis at `p`; each
 /// point starts Newton from the previous one. It stops with [`BranchStop::NotConverged`] where
-/// Newton fails (it does not follow folds). Stability as in [`Continuation`].
+/// Newton fails (it does not follow folds). Stability as in [`Continuation`]; `formulation`
+/// as in [`HarmonicBalance::with_formulation`] (the points always hold every DOF).
 pub fn parameter_sweep(
     values: &[f64],
     mut build: impl FnMut(f64) -> Result<(Model, HarmonicBasis)>,
     stability: Option<FloquetOptions>,
+    formulation: Formulation,
     mut progress: impl FnMut(f64),
 ) -> Result<Branch> {
     let mut branch: Option<Branch> = None;
     let mut previous: Option<Vec<Complex64>> = None;
     let cont = Continuation {
         stability,
+        formulation,
         ..Continuation::default()
     };
     for (i, &p) in values.iter().enumerate() {
@@ -40,11 +43,12 @@ pub fn parameter_sweep(
                 None => return Err(e),
             },
         };
-        let mut hb = HarmonicBalance::new(&model, basis)?;
+        let mut hb = HarmonicBalance::with_formulation(&model, basis, formulation)?;
         crate::solve::check_dense_for_continuation(&hb)?;
         let mut ws = hb.workspace();
+        let full = (basis.harmonics() + 1) * model.n_dofs();
         let sol = match &previous {
-            Some(q) if q.len() == hb.len() => Newton::new()
+            Some(q) if q.len() == full => Newton::new()
                 .with_tolerance(cont.tolerance)?
                 .solve_from(&hb, q, &mut ws)?,
             // The first value: the robust start (other solvers, load homotopy).
