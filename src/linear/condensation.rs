@@ -66,7 +66,28 @@ impl Condensation {
             }
         }
         let pattern = SparsePattern::new(model.mass(), &model.d0(), &model.k0());
-        let z = SparseDynamicStiffness::new(pattern, basis)?;
+        let z = match SparseDynamicStiffness::new(pattern.clone(), basis) {
+            Err(e @ Error::SingularDynamicStiffness { harmonic: 0, .. }) => {
+                // A free-free model: harmonic 0 in the complement of its rigid-body modes.
+                let shift = crate::model::RigidModes::shift(model);
+                let Ok(shifted) = SparseDynamicStiffness::shifted_static(pattern.clone(), shift)
+                else {
+                    return Err(e);
+                };
+                let rigid = crate::model::RigidModes::find(model, |x| {
+                    shifted.solve_static_real(x)
+                });
+                let Some(rigid) = rigid else {
+                    return Err(e);
+                };
+                SparseDynamicStiffness::new_free(
+                    pattern,
+                    basis,
+                    Some((std::sync::Arc::new(rigid), shift)),
+                )?
+            }
+            z => z?,
+        };
         Ok((
             Self {
                 coordinates,
@@ -90,6 +111,11 @@ impl Condensation {
     /// The coordinates' names.
     pub fn names(&self) -> &[String] {
         &self.names
+    }
+
+    /// The rigid-body modes of a free-free model (harmonic 0 is solved in their complement).
+    pub fn rigid_modes(&self) -> Option<&std::sync::Arc<crate::model::RigidModes>> {
+        self.z.rigid_modes()
     }
 
     /// Factors `Z_k` for another Ω.
