@@ -63,7 +63,7 @@ fn linear_three_inertia_chain_equals_the_closed_form() {
         let q1 = z.lu().solve(&f).unwrap();
         for i in 0..3 {
             let d = (sol.harmonic(i, 1) - q1[i]).norm();
-            assert!(d < 1e-12 * q1.amax(), "dof {i}: {d:e}");
+            assert!(d < 1e-12 * q1.camax(), "dof {i}: {d:e}");
         }
     }
 }
@@ -170,7 +170,8 @@ fn backlash_drivetrain_equals_a_softly_grounded_one() {
 fn condensed_equals_full_on_a_free_free_drivetrain() {
     let model = drivetrain(0.0, BALANCED);
     let basis = HarmonicBasis::new(300.0, 24).unwrap();
-    let full = newton(&HarmonicBalance::with_formulation(&model, basis, Formulation::Full).unwrap());
+    let full =
+        newton(&HarmonicBalance::with_formulation(&model, basis, Formulation::Full).unwrap());
     let hb = HarmonicBalance::with_formulation(&model, basis, Formulation::Condensed).unwrap();
     assert!(hb.is_condensed() && hb.rigid_modes().is_some());
     let cond = newton(&hb);
@@ -200,7 +201,10 @@ fn unbalanced_static_loads_are_an_error() {
 
 #[test]
 fn cli_rejects_an_unbalanced_scene_with_exit_code_2() {
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/free_free_drivetrain.toml");
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/scenes/free_free_drivetrain.toml"
+    );
     let text = std::fs::read_to_string(scene).unwrap();
     let marker = "# load torque";
     let line = text.lines().find(|l| l.contains(marker)).unwrap();
@@ -213,7 +217,10 @@ fn cli_rejects_an_unbalanced_scene_with_exit_code_2() {
         let out = common::hbal(&[cmd, path.to_str().unwrap()]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{cmd}: {stderr}");
-        assert!(stderr.contains("the static loads do not balance"), "{stderr}");
+        assert!(
+            stderr.contains("the static loads do not balance"),
+            "{stderr}"
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -66,28 +66,20 @@ impl Condensation {
             }
         }
         let pattern = SparsePattern::new(model.mass(), &model.d0(), &model.k0());
-        let z = match SparseDynamicStiffness::new(pattern.clone(), basis) {
-            Err(e @ Error::SingularDynamicStiffness { harmonic: 0, .. }) => {
-                // A free-free model: harmonic 0 in the complement of its rigid-body modes.
-                let shift = crate::model::RigidModes::shift(model);
-                let Ok(shifted) = SparseDynamicStiffness::shifted_static(pattern.clone(), shift)
-                else {
-                    return Err(e);
-                };
-                let rigid = crate::model::RigidModes::find(model, |x| {
-                    shifted.solve_static_real(x)
-                });
-                let Some(rigid) = rigid else {
-                    return Err(e);
-                };
-                SparseDynamicStiffness::new_free(
-                    pattern,
-                    basis,
-                    Some((std::sync::Arc::new(rigid), shift)),
-                )?
-            }
-            z => z?,
-        };
+        // Rigid-body modes are looked for on every model: a sparse `L D Lᵀ` of a singular
+        // `K0` can pass its backward-error test (a rounding-sized pivot), so a failed
+        // factorisation is no signal. One factorisation of `K0 + σM` and a few solves, O(n).
+        let shift = crate::model::RigidModes::shift(model);
+        let rigid = SparseDynamicStiffness::shifted_static(pattern.clone(), shift)
+            .ok()
+            .and_then(|shifted| {
+                crate::model::RigidModes::find(model, |x| shifted.solve_static_real(x))
+            });
+        let z = SparseDynamicStiffness::new_free(
+            pattern,
+            basis,
+            rigid.map(|r| (std::sync::Arc::new(r), shift)),
+        )?;
         Ok((
             Self {
                 coordinates,

@@ -169,10 +169,12 @@ impl RigidModes {
         T: std::ops::SubAssign + Default,
     {
         for c in 0..self.len() {
-            let a = self.modes.column(c).iter().zip(x.iter()).fold(
-                T::default(),
-                |acc, (&r, &v)| acc + v * r,
-            );
+            let a = self
+                .modes
+                .column(c)
+                .iter()
+                .zip(x.iter())
+                .fold(T::default(), |acc, (&r, &v)| acc + v * r);
             for (xi, &m) in x.iter_mut().zip(self.mass_modes.column(c).iter()) {
                 *xi -= a * m;
             }
@@ -186,10 +188,12 @@ impl RigidModes {
         T: std::ops::SubAssign + Default,
     {
         for c in 0..self.len() {
-            let a = self.mass_modes.column(c).iter().zip(q.iter()).fold(
-                T::default(),
-                |acc, (&m, &v)| acc + v * m,
-            );
+            let a = self
+                .mass_modes
+                .column(c)
+                .iter()
+                .zip(q.iter())
+                .fold(T::default(), |acc, (&m, &v)| acc + v * m);
             for (qi, &r) in q.iter_mut().zip(self.modes.column(c).iter()) {
                 *qi -= a * r;
             }
@@ -202,13 +206,20 @@ impl RigidModes {
     pub fn check_balance(&self, model: &Model, f0: &[f64]) -> Result<()> {
         for c in 0..self.len() {
             let r = self.modes.column(c);
-            let (reference, top) = r
+            // The first DOF that moves most (to rounding: equal entries pick the first).
+            let top = r.amax();
+            let reference = r
                 .iter()
-                .enumerate()
-                .fold((0, 0.0_f64), |b, (i, v)| if v.abs() > b.1 { (i, v.abs()) } else { b });
+                .position(|v| v.abs() >= (1.0 - 1e-9) * top)
+                .unwrap_or(0);
             let sign = r[reference].signum();
             let net: f64 = r.iter().zip(f0).map(|(ri, fi)| ri * fi).sum::<f64>() * sign / top;
-            let gross: f64 = r.iter().zip(f0).map(|(ri, fi)| (ri * fi).abs()).sum::<f64>() / top;
+            let gross: f64 = r
+                .iter()
+                .zip(f0)
+                .map(|(ri, fi)| (ri * fi).abs())
+                .sum::<f64>()
+                / top;
             if net.abs() > BALANCE_TOLERANCE * gross {
                 let names = model.dof_names();
                 let loaded: Vec<String> = (0..f0.len())
