@@ -224,3 +224,32 @@ fn cli_rejects_an_unbalanced_scene_with_exit_code_2() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A singular `K0` whose null motion is restrained by an element without linear stiffness
+/// (a pure cubic spring to ground) is not a rigid-body mode: the singular error stays.
+#[test]
+fn a_motion_held_only_by_a_nonlinear_element_is_not_free() {
+    let model = Model::builder(&["a", "b"])
+        .mass_diagonal(&[1.0, 1.0])
+        .element(
+            "shaft",
+            &[("a", 1.0), ("b", -1.0)],
+            LinearSpring::new(10.0, 0.1),
+        )
+        .element(
+            "cubic",
+            &[("a", 1.0)],
+            hbal::force::CubicSpring::new(0.0, 5.0),
+        )
+        .load("a", 1, 1.0, 0.0)
+        .build()
+        .unwrap();
+    for formulation in [Formulation::Full, Formulation::Condensed] {
+        let basis = HarmonicBasis::new(3.0, 4).unwrap();
+        let err = HarmonicBalance::with_formulation(&model, basis, formulation).unwrap_err();
+        assert!(
+            matches!(err, Error::SingularDynamicStiffness { harmonic: 0, .. }),
+            "{formulation:?}: {err}"
+        );
+    }
+}

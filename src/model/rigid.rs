@@ -24,7 +24,7 @@
 //! **Finding R** scale-independently: subspace iteration `X ← (K0 + σM)⁻¹ M X` with a tiny
 //! shift `σ = 10⁻¹⁰ ‖K0‖/‖M‖` amplifies rigid components by `1/σ` against `1/(λ + σ)` for the
 //! elastic modes; a Rayleigh–Ritz step separates them, and a candidate is kept only if nothing
-//! restrains it ([`is_free`], measured on `K`, `D` and the weights themselves).
+//! restrains it (`is_free`, measured on `K`, `D` and the weights themselves).
 
 use super::Model;
 use crate::error::{Error, Result};
