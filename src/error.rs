@@ -97,6 +97,17 @@ pub enum Error {
         /// What to change.
         hint: String,
     },
+    /// A free-free model whose mean external loads do work on a rigid-body mode: the
+    /// drivetrain would accelerate, so there is no periodic solution.
+    #[error("the static loads do not balance: net torque {net:.6e} N m on the rigid-body mode (referred to DOF `{reference}`, loaded: {loaded}) (the drivetrain would accelerate: no periodic solution)")]
+    UnbalancedStaticLoad {
+        /// `rᵀ f_0`, with `r` scaled to turn `reference` by 1 rad.
+        net: f64,
+        /// The DOF that moves most in the mode.
+        reference: String,
+        /// The loaded DOFs of the mode with their mean loads.
+        loaded: String,
+    },
     /// A computation produced NaN or infinity.
     #[error("non-finite value in {what}")]
     NonFinite {

@@ -25,14 +25,31 @@ impl DynamicStiffness {
         d0: &DMatrix<f64>,
         k0: &DMatrix<f64>,
     ) -> Result<Self> {
+        Self::with_static_augmentation(basis, m, d0, k0, None)
+    }
+
+    /// [`DynamicStiffness::new`] with `Z_0 = K0 + A` for a free-free model, `A = s M R Rᵀ M`
+    /// ([`RigidModes::augmentation`](crate::model::RigidModes::augmentation)): regular, and
+    /// its solutions are the static solutions `K0 q_0 = f_0` with `Rᵀ M q_0 = 0` (see
+    /// [`crate::model::rigid`]). Harmonics `k >= 1` are unchanged.
+    pub fn with_static_augmentation(
+        basis: &HarmonicBasis,
+        m: &DMatrix<f64>,
+        d0: &DMatrix<f64>,
+        k0: &DMatrix<f64>,
+        augmentation: Option<&DMatrix<f64>>,
+    ) -> Result<Self> {
         let n = m.nrows();
         let mut matrices = Vec::with_capacity(basis.harmonics() + 1);
         let mut factors = Vec::with_capacity(basis.harmonics() + 1);
         for k in 0..=basis.harmonics() {
             let w = k as f64 * basis.fundamental();
-            let z = DMatrix::from_fn(n, n, |i, j| {
+            let mut z = DMatrix::from_fn(n, n, |i, j| {
                 Complex64::new(k0[(i, j)] - w * w * m[(i, j)], w * d0[(i, j)])
             });
+            if let (0, Some(a)) = (k, augmentation) {
+                z += a.map(|v| Complex64::new(v, 0.0));
+            }
             let scale = k0.amax().max(w * w * m.amax()).max(w * d0.amax());
             let lu = z.clone().lu();
             let u = lu.u();
@@ -42,8 +59,9 @@ impl DynamicStiffness {
             let relative_pivot = if scale > 0.0 { min_pivot / scale } else { 0.0 };
             if relative_pivot.is_nan() || relative_pivot <= SINGULAR_PIVOT {
                 let hint = if k == 0 {
-                    "K0 is singular: a free rigid-body mode; ground it with a stiffness or \
-                     fix the DOF"
+                    "K0 is singular, but not by a free rigid-body mode (free-free models are \
+                     handled): a motion held only by an element without linear stiffness, or a \
+                     massless DOF; ground it with a stiffness or fix the DOF"
                         .to_string()
                 } else {
                     format!(

@@ -66,7 +66,20 @@ impl Condensation {
             }
         }
         let pattern = SparsePattern::new(model.mass(), &model.d0(), &model.k0());
-        let z = SparseDynamicStiffness::new(pattern, basis)?;
+        // Rigid-body modes are looked for on every model: a sparse `L D Lᵀ` of a singular
+        // `K0` can pass its backward-error test (a rounding-sized pivot), so a failed
+        // factorisation is no signal. One factorisation of `K0 + σM` and a few solves, O(n).
+        let shift = crate::model::RigidModes::shift(model);
+        let rigid = SparseDynamicStiffness::shifted_static(pattern.clone(), shift)
+            .ok()
+            .and_then(|shifted| {
+                crate::model::RigidModes::find(model, |x| shifted.solve_static_real(x))
+            });
+        let z = SparseDynamicStiffness::new_free(
+            pattern,
+            basis,
+            rigid.map(|r| (std::sync::Arc::new(r), shift)),
+        )?;
         Ok((
             Self {
                 coordinates,
@@ -90,6 +103,11 @@ impl Condensation {
     /// The coordinates' names.
     pub fn names(&self) -> &[String] {
         &self.names
+    }
+
+    /// The rigid-body modes of a free-free model (harmonic 0 is solved in their complement).
+    pub fn rigid_modes(&self) -> Option<&std::sync::Arc<crate::model::RigidModes>> {
+        self.z.rigid_modes()
     }
 
     /// Factors `Z_k` for another Ω.

@@ -109,19 +109,19 @@ impl SparsePattern {
         self.n
     }
 
-    /// The values of `Z(w) = -w² M + i w D0 + K0` on the pattern.
-    fn values(&self, w: f64) -> Vec<Complex64> {
+    /// The values of `Z(w) + s M = -(w² - s) M + i w D0 + K0` on the pattern.
+    fn values(&self, w: f64, s: f64) -> Vec<Complex64> {
         (0..self.nnz())
-            .map(|p| Complex64::new(self.k[p] - w * w * self.m[p], w * self.d[p]))
+            .map(|p| Complex64::new(self.k[p] - (w * w - s) * self.m[p], w * self.d[p]))
             .collect()
     }
 
-    /// `out ← Z(w) x`.
-    fn apply(&self, w: f64, x: &[Complex64], out: &mut [Complex64]) {
+    /// `out ← (Z(w) + s M) x`.
+    fn apply(&self, w: f64, s: f64, x: &[Complex64], out: &mut [Complex64]) {
         out.fill(Complex64::default());
         for (j, xj) in x.iter().enumerate() {
             for p in self.col_ptr[j]..self.col_ptr[j + 1] {
-                let z = Complex64::new(self.k[p] - w * w * self.m[p], w * self.d[p]);
+                let z = Complex64::new(self.k[p] - (w * w - s) * self.m[p], w * self.d[p]);
                 out[self.row_idx[p]] += z * xj;
             }
         }
@@ -176,6 +176,10 @@ pub struct SparseDynamicStiffness {
     fundamental: f64,
     factors: Vec<Factor>,
     work: RefCell<Vec<Complex64>>,
+    /// The shift `σ` of the static factor `K0 + σM` (0 for a regular `K0`).
+    shift: f64,
+    /// Rigid-body modes of a free-free model: harmonic 0 solves in their complement.
+    rigid: Option<std::sync::Arc<crate::model::RigidModes>>,
 }
 
 impl std::fmt::Debug for SparseDynamicStiffness {
@@ -201,6 +205,49 @@ impl SparseDynamicStiffness {
     /// Orders the pattern once (envelope or symbolic LU) and factors `Z_k` for every
     /// harmonic of `basis`; an error names the first singular harmonic.
     pub fn new(pattern: SparsePattern, basis: &HarmonicBasis) -> Result<Self> {
+        Self::new_free(pattern, basis, None)
+    }
+
+    /// [`SparseDynamicStiffness::new`] for a free-free model with rigid-body modes `R` and the
+    /// shift `σ` ([`RigidModes::shift`](crate::model::RigidModes::shift)): harmonic 0 is
+    /// factored as `K0 + σM` and [`solve_in_place`](Self::solve_in_place) at k = 0 returns
+    /// `K0⁺ x`, the solution of `K0 q = Πᵀ x` with `Rᵀ M q = 0` (`Πᵀ x = x - M R Rᵀ x`),
+    /// by two steps of iterative refinement (each multiplies the error of mode `λ` by
+    /// `σ/(λ + σ)`, about 1e-10).
+    pub fn new_free(
+        pattern: SparsePattern,
+        basis: &HarmonicBasis,
+        rigid: Option<(std::sync::Arc<crate::model::RigidModes>, f64)>,
+    ) -> Result<Self> {
+        let mut s = Self::ordered(pattern, basis.fundamental());
+        if let Some((r, shift)) = rigid {
+            s.rigid = Some(r);
+            s.shift = shift;
+        }
+        s.refactor(basis)?;
+        Ok(s)
+    }
+
+    /// `K0 + σM` alone (harmonic 0, no projection): for finding the rigid-body modes.
+    pub fn shifted_static(pattern: SparsePattern, shift: f64) -> Result<Self> {
+        let mut s = Self::ordered(pattern, 0.0);
+        s.shift = shift;
+        let f = s.factor(0, 0.0)?;
+        s.factors.push(f);
+        Ok(s)
+    }
+
+    /// `x ← (K0 + σM)⁻¹ x` in real arithmetic with the static factor.
+    pub fn solve_static_real(&self, x: &mut [f64]) {
+        let mut c: Vec<Complex64> = x.iter().map(|&v| Complex64::new(v, 0.0)).collect();
+        self.solve_with(&self.factors[0], &mut c, 1);
+        for (xi, ci) in x.iter_mut().zip(&c) {
+            *xi = ci.re;
+        }
+    }
+
+    /// The ordering (envelope or none), nothing factored yet.
+    fn ordered(pattern: SparsePattern, fundamental: f64) -> Self {
         let n = pattern.n;
         let envelope = pattern.is_symmetric().then(|| {
             let (col_ptr, row_idx) = (&pattern.col_ptr, &pattern.row_idx);
@@ -216,16 +263,16 @@ impl SparseDynamicStiffness {
         });
         let envelope =
             envelope.filter(|(env, _)| env.size() <= MAX_ENVELOPE_FILL * pattern.nnz() + n);
-        let mut s = Self {
+        Self {
             pattern,
             envelope,
             symbolic: None,
-            fundamental: basis.fundamental(),
+            fundamental,
             factors: Vec::new(),
             work: RefCell::new(vec![Complex64::default(); n]),
-        };
-        s.refactor(basis)?;
-        Ok(s)
+            shift: 0.0,
+            rigid: None,
+        }
     }
 
     /// Factors `Z_k` again for another Ω (same ordering, same symbolic analysis).
@@ -233,8 +280,17 @@ impl SparseDynamicStiffness {
         self.fundamental = basis.fundamental();
         self.factors.clear();
         for k in 0..=basis.harmonics() {
-            let w = k as f64 * self.fundamental;
-            let values = self.pattern.values(w);
+            let f = self.factor(k, k as f64 * self.fundamental)?;
+            self.factors.push(f);
+        }
+        Ok(())
+    }
+
+    /// The factor of `Z_k` at `w = kΩ` (`K0 + σM` at k = 0).
+    fn factor(&mut self, k: usize, w: f64) -> Result<Factor> {
+        {
+            let s = if k == 0 { self.shift } else { 0.0 };
+            let values = self.pattern.values(w, s);
             let mut factor = None;
             if let Some((env, slots)) = &self.envelope {
                 let mut v = vec![Complex64::default(); env.size()];
@@ -243,7 +299,7 @@ impl SparseDynamicStiffness {
                 }
                 if env.factor(&mut v) {
                     let f = Factor::Envelope(v);
-                    if self.backward_error(&f, w, &values) < SINGULAR_RESIDUAL {
+                    if self.backward_error(&f, w, s, &values) < SINGULAR_RESIDUAL {
                         factor = Some(f);
                     }
                 }
@@ -252,7 +308,7 @@ impl SparseDynamicStiffness {
                 Some(f) => f,
                 None => {
                     let f = self.lu(values.clone()).ok_or_else(|| singular(k, w, 0.0))?;
-                    let rel = self.backward_error(&f, w, &values);
+                    let rel = self.backward_error(&f, w, s, &values);
                     if rel.is_nan() || rel >= SINGULAR_RESIDUAL {
                         return Err(singular(
                             k,
@@ -263,9 +319,8 @@ impl SparseDynamicStiffness {
                     f
                 }
             };
-            self.factors.push(factor);
+            Ok(factor)
         }
-        Ok(())
     }
 
     /// faer's LU of the values on the pattern (symbolic analysis on first use).
@@ -282,7 +337,7 @@ impl SparseDynamicStiffness {
     }
 
     /// The backward error of solving with `f` for `b = (1, 2, ..., n)`.
-    fn backward_error(&self, f: &Factor, w: f64, values: &[Complex64]) -> f64 {
+    fn backward_error(&self, f: &Factor, w: f64, s: f64, values: &[Complex64]) -> f64 {
         let n = self.pattern.n;
         let b: Vec<Complex64> = (0..n)
             .map(|i| Complex64::new(1.0 + i as f64, 0.0))
@@ -290,7 +345,7 @@ impl SparseDynamicStiffness {
         let mut x = b.clone();
         self.solve_with(f, &mut x, 1);
         let mut back = vec![Complex64::default(); n];
-        self.pattern.apply(w, &x, &mut back);
+        self.pattern.apply(w, s, &x, &mut back);
         let norm = |v: &[Complex64]| v.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
         let err = back
             .iter()
@@ -335,8 +390,43 @@ impl SparseDynamicStiffness {
 
     /// `x ← Z_k⁻¹ x` for `columns` right-hand sides stored one after the other (column-major
     /// `n × columns`).
+    /// At k = 0 of a free-free model: `K0⁺ x` per column (see [`Self::new_free`]).
     pub fn solve_in_place(&self, k: usize, x: &mut [Complex64], columns: usize) {
-        self.solve_with(&self.factors[k], x, columns);
+        match (&self.rigid, k) {
+            (Some(rigid), 0) => {
+                let n = self.pattern.n;
+                for col in x.chunks_mut(n).take(columns) {
+                    self.solve_free(rigid, col);
+                }
+            }
+            _ => self.solve_with(&self.factors[k], x, columns),
+        }
+    }
+
+    /// `x ← K0⁺ x` in the complement of the rigid-body modes: `b = Πᵀ x`,
+    /// `q ← Π (K0 + σM)⁻¹ b`, then twice `q ← q + Π (K0 + σM)⁻¹ (b - K0 q)`.
+    fn solve_free(&self, rigid: &crate::model::RigidModes, x: &mut [Complex64]) {
+        rigid.project_load(x);
+        let b = x.to_vec();
+        let mut r = vec![Complex64::default(); x.len()];
+        self.solve_with(&self.factors[0], x, 1);
+        rigid.project_motion(x);
+        for _ in 0..2 {
+            self.pattern.apply(0.0, 0.0, x, &mut r);
+            for (ri, bi) in r.iter_mut().zip(&b) {
+                *ri = bi - *ri;
+            }
+            self.solve_with(&self.factors[0], &mut r, 1);
+            rigid.project_motion(&mut r);
+            for (xi, ri) in x.iter_mut().zip(&r) {
+                *xi += ri;
+            }
+        }
+    }
+
+    /// The rigid-body modes harmonic 0 is solved in the complement of (free-free models).
+    pub fn rigid_modes(&self) -> Option<&std::sync::Arc<crate::model::RigidModes>> {
+        self.rigid.as_ref()
     }
 
     /// How many harmonics use the envelope `L D Lᵀ` (the rest use the sparse LU).
@@ -361,7 +451,7 @@ impl SparseDynamicStiffness {
 
     /// `out ← Z_k x`.
     pub fn apply(&self, k: usize, x: &[Complex64], out: &mut [Complex64]) {
-        self.pattern.apply(k as f64 * self.fundamental, x, out);
+        self.pattern.apply(k as f64 * self.fundamental, 0.0, x, out);
     }
 }
 
@@ -383,7 +473,7 @@ pub fn is_positive_definite(a: &SparseMatrix) -> bool {
 /// The error of a singular `Z_k` at frequency `w`.
 fn singular(k: usize, w: f64, relative_pivot: f64) -> Error {
     let hint = if k == 0 {
-        "K0 is singular: a free rigid-body mode; ground it with a stiffness or fix the DOF"
+        "K0 is singular, but not by a free rigid-body mode (free-free models are handled): a motion held only by an element without linear stiffness, or a massless DOF; ground it with a stiffness or fix the DOF"
             .to_string()
     } else {
         format!(

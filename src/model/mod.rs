@@ -10,11 +10,13 @@
 mod builder;
 mod element;
 mod load;
+pub mod rigid;
 mod sparse;
 
 pub use builder::ModelBuilder;
 pub use element::Element;
 pub use load::Load;
+pub use rigid::RigidModes;
 pub use sparse::SparseMatrix;
 
 use crate::error::{Error, Result};

@@ -29,6 +29,21 @@ fn scatter_add(weights: &[(usize, f64)], f: Complex64, out: &mut [Complex64]) {
     }
 }
 
+/// `Z_k` of a free-free model: `Z_0 = K0 + s M R Rᵀ M` (see [`crate::model::rigid`]).
+fn free_dynamic_stiffness(
+    basis: &HarmonicBasis,
+    dense: &crate::model::DenseMatrices,
+    rigid: &crate::model::RigidModes,
+) -> Result<DynamicStiffness> {
+    DynamicStiffness::with_static_augmentation(
+        basis,
+        &dense.mass,
+        &dense.d0,
+        &dense.k0,
+        Some(&rigid.augmentation()),
+    )
+}
+
 /// A model discretised on a harmonic basis: AFT plan, factored `Z_k`, load harmonics.
 ///
 /// Build it once per (model, Ω, H, N) and reuse it for any number of solves; every solve needs
@@ -53,6 +68,8 @@ pub struct HarmonicBalance<'m> {
     /// The condensation onto the element coordinates, with the full `F_split` it recovers
     /// `Q` from (see [`crate::linear::condensation`]).
     condensed: Option<Box<(crate::linear::Condensation, Vec<Complex64>)>>,
+    /// Rigid-body modes of a free-free model (full formulation: `Z_0 = K0 + s M R Rᵀ M`).
+    rigid: Option<std::sync::Arc<crate::model::RigidModes>>,
 }
 
 /// A time-varying or nonlinear element, the law the AFT evaluates for it (its band-limited
@@ -218,16 +235,45 @@ impl<'m> HarmonicBalance<'m> {
             n,
             names: model.dof_names().to_vec(),
             condensed: None,
+            rigid: None,
         };
+        let mean_load: Vec<f64> = hb.f_ext[..n].iter().map(|v| v.re).collect();
         match formulation.resolve(model) {
             Formulation::Full | Formulation::Auto => {
                 let dense = model.dense("full formulation")?;
-                hb.z = DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?;
+                hb.z = match DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0) {
+                    Err(e @ Error::SingularDynamicStiffness { harmonic: 0, .. }) => {
+                        let Some(rigid) = crate::model::rigid::find_dense(model, &dense) else {
+                            return Err(e);
+                        };
+                        rigid.check_balance(model, &mean_load)?;
+                        let z = free_dynamic_stiffness(&basis, &dense, &rigid)?;
+                        hb.rigid = Some(std::sync::Arc::new(rigid));
+                        z
+                    }
+                    z => z?,
+                };
                 hb.dense = Some(Box::new(dense));
             }
-            Formulation::Condensed => hb.condense()?,
+            Formulation::Condensed => {
+                hb.condense()?;
+                hb.rigid = hb
+                    .condensed
+                    .as_ref()
+                    .and_then(|c| c.0.rigid_modes().cloned());
+                if let Some(rigid) = &hb.rigid {
+                    rigid.check_balance(model, &mean_load)?;
+                }
+            }
         }
         Ok(hb)
+    }
+
+    /// The rigid-body modes of a free-free model, whose static part is solved in their
+    /// complement with the mean rigid angle `Rᵀ M q_0 = 0` (see [`crate::model::rigid`]);
+    /// `None` for a grounded model.
+    pub fn rigid_modes(&self) -> Option<&crate::model::RigidModes> {
+        self.rigid.as_deref()
     }
 
     /// The model.
@@ -517,7 +563,10 @@ impl<'m> HarmonicBalance<'m> {
                 reason: "no dense matrices for the full formulation".into(),
             });
         };
-        self.z = DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?;
+        self.z = match &self.rigid {
+            Some(rigid) => free_dynamic_stiffness(&basis, dense, rigid)?,
+            None => DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?,
+        };
         self.basis = basis;
         Ok(())
     }

@@ -8,6 +8,7 @@
 //! and the multipliers that decide stability are those of `Wᵀ Φ W`.
 
 use super::system::Coordinates;
+use crate::model::rigid::is_free;
 use nalgebra::DMatrix;
 
 /// Orthonormal basis (columns) of the rigid-body modes in the coordinates `sys`.
@@ -52,40 +53,6 @@ fn in_dofs(sys: &Coordinates) -> DMatrix<f64> {
         r.set_column(c, &eig.eigenvectors.column(i));
     }
     r
-}
-
-/// Largest relative restraint of `x` (in the model's DOFs) that still counts as rounding:
-/// `‖K x‖∞ / (max|K| ‖x‖∞)` and the same for `D` and every element's `w·x`.
-const FREE_TOLERANCE: f64 = 1e-9;
-
-/// `true` if nothing restrains the motion `x` beyond rounding, measured on the matrices
-/// themselves. The eigenvalues of `G` are squares (a soft ground spring of 500 N m/rad
-/// against shaft elements of 1e9 N m/rad sits at 1e-13 of the largest and passes their
-/// test); this unsquared residual tells it apart (5e-7 there, 1e-15 for a rigid-body mode).
-fn is_free(model: &crate::model::Model, x: &[f64]) -> bool {
-    let scale = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    if scale == 0.0 {
-        return false;
-    }
-    let mut y = vec![0.0; x.len()];
-    for a in [model.structural_stiffness(), model.structural_damping()] {
-        let top = a.amax();
-        if top == 0.0 {
-            continue;
-        }
-        y.fill(0.0);
-        a.mul_add(1.0, x, &mut y);
-        if y.iter().any(|v| v.abs() > FREE_TOLERANCE * top * scale) {
-            return false;
-        }
-    }
-    model.elements().iter().all(|e| {
-        let top = e
-            .weights()
-            .iter()
-            .fold(0.0_f64, |m, &(_, w)| m.max(w.abs()));
-        e.gather(x).abs() <= FREE_TOLERANCE * top * scale
-    })
 }
 
 /// The rigid-body modes of the model inside the span of the basis `V`, by the same test as in
