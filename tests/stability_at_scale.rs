@@ -31,16 +31,7 @@ fn drivetrain(n: usize) -> (Model, Solution) {
 
 /// `max_i min_j |a_i - b_j|` both ways over all multipliers.
 fn hausdorff(a: &[Complex64], b: &[Complex64]) -> f64 {
-    let one = |a: &[Complex64], b: &[Complex64]| {
-        a.iter()
-            .map(|x| {
-                b.iter()
-                    .map(|y| (x - y).norm())
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .fold(0.0, f64::max)
-    };
-    one(a, b).max(one(b, a))
+    one_way(a, b).max(one_way(b, a))
 }
 
 fn both(model: &Model, solution: &Solution, options: FloquetOptions) -> (Floquet, Floquet) {

@@ -168,17 +168,7 @@ impl RigidModes {
         T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
         T: std::ops::SubAssign + Default,
     {
-        for c in 0..self.len() {
-            let a = self
-                .modes
-                .column(c)
-                .iter()
-                .zip(x.iter())
-                .fold(T::default(), |acc, (&r, &v)| acc + v * r);
-            for (xi, &m) in x.iter_mut().zip(self.mass_modes.column(c).iter()) {
-                *xi -= a * m;
-            }
-        }
+        self.project(x, &self.modes, &self.mass_modes);
     }
 
     /// `q ← q - R (Rᵀ M q)`: the M-orthogonal projection onto the complement.
@@ -187,15 +177,23 @@ impl RigidModes {
         T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
         T: std::ops::SubAssign + Default,
     {
+        self.project(q, &self.mass_modes, &self.modes);
+    }
+
+    /// `x ← x - Σ_c along_c (measure_cᵀ x)`: the oblique projection both of the above are.
+    fn project<T>(&self, x: &mut [T], measure: &DMatrix<f64>, along: &DMatrix<f64>)
+    where
+        T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
+        T: std::ops::SubAssign + Default,
+    {
         for c in 0..self.len() {
-            let a = self
-                .mass_modes
+            let a = measure
                 .column(c)
                 .iter()
-                .zip(q.iter())
-                .fold(T::default(), |acc, (&m, &v)| acc + v * m);
-            for (qi, &r) in q.iter_mut().zip(self.modes.column(c).iter()) {
-                *qi -= a * r;
+                .zip(x.iter())
+                .fold(T::default(), |acc, (&r, &v)| acc + v * r);
+            for (xi, &m) in x.iter_mut().zip(along.column(c).iter()) {
+                *xi -= a * m;
             }
         }
     }
