@@ -33,6 +33,14 @@ pub enum Error {
         /// The model's DOF names, comma separated.
         known: String,
     },
+    /// An element's fields contradict each other (e.g. both or neither of two alternatives).
+    #[error("{context}: {reason}")]
+    InvalidElement {
+        /// The element, e.g. ``element `mesh` ``.
+        context: String,
+        /// What is wrong, naming the fields.
+        reason: String,
+    },
     /// Two DOFs share a name, or there are none.
     #[error("invalid DOF list: {reason}")]
     InvalidDofs {

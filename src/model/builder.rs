@@ -1,12 +1,16 @@
 //! Validating builder for [`Model`].
 
-use super::{Element, Load, Model, SparseMatrix};
+use super::{Element, GearStage, Load, Model, SparseMatrix};
 use crate::error::{Error, Result};
 use crate::force::ForceLaw;
 use nalgebra::DMatrix;
 
-/// An element as given: name, `(DOF name, weight)` pairs, law.
-type PendingElement = (String, Vec<(String, f64)>, Box<dyn ForceLaw>);
+/// An element as given: name, `(DOF name, weight)` pairs and law, or a gear stage.
+#[derive(Debug)]
+enum PendingElement {
+    Law(String, Vec<(String, f64)>, Box<dyn ForceLaw>),
+    Stage(String, GearStage),
+}
 
 /// A matrix as given: dense, or assembled from triplets.
 #[derive(Debug, Clone)]
@@ -136,7 +140,16 @@ impl ModelBuilder {
         law: Box<dyn ForceLaw>,
     ) -> Self {
         let w = weights.iter().map(|(d, w)| (d.to_string(), *w)).collect();
-        self.elements.push((name.to_string(), w, law));
+        self.elements
+            .push(PendingElement::Law(name.to_string(), w, law));
+        self
+    }
+
+    /// Adds a gear stage: the mesh on the transmission error `u = r_b1 θ1 - r_b2 θ2` of its
+    /// driving and driven DOF ([`GearStage`] for the sign convention).
+    pub fn gear_stage(mut self, name: &str, stage: GearStage) -> Self {
+        self.elements
+            .push(PendingElement::Stage(name.to_string(), stage));
         self
     }
 
@@ -215,7 +228,16 @@ impl ModelBuilder {
         }
 
         let mut elements = Vec::with_capacity(self.elements.len());
-        for (name, weights, law) in self.elements {
+        for pending in self.elements {
+            let (name, weights, law, stage) = match pending {
+                PendingElement::Law(name, weights, law) => (name, weights, law, None),
+                PendingElement::Stage(name, stage) => {
+                    stage.validate(&format!("gear stage `{name}`"))?;
+                    let (weights, law) = stage.element();
+                    let weights = weights.iter().map(|(d, w)| (d.to_string(), *w)).collect();
+                    (name, weights, law, Some(stage))
+                }
+            };
             let ctx = format!("element `{name}`");
             if weights.is_empty() {
                 return Err(Error::DimensionMismatch {
@@ -245,6 +267,7 @@ impl ModelBuilder {
                 weights: w,
                 law,
                 linear,
+                stage,
             });
         }
 

@@ -9,12 +9,14 @@
 
 mod builder;
 mod element;
+pub mod gear_stage;
 mod load;
 pub mod rigid;
 mod sparse;
 
 pub use builder::ModelBuilder;
 pub use element::Element;
+pub use gear_stage::GearStage;
 pub use load::Load;
 pub use rigid::RigidModes;
 pub use sparse::SparseMatrix;

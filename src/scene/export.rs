@@ -149,6 +149,23 @@ pub fn write_scene(model: &Model, settings: &SceneSettings, path: &Path) -> Resu
     doc.insert("solver".into(), Value::Object(solver));
     let mut elements = Vec::with_capacity(model.elements().len());
     for e in model.elements() {
+        if let Some(stage) = e.gear_stage() {
+            let mut element = Map::new();
+            element.insert("name".into(), json!(e.name()));
+            element.insert("type".into(), json!("gear_stage"));
+            let mut fields = serde_json::to_value(stage).map_err(|x| SceneError {
+                file: file.clone(),
+                position: None,
+                path: Some(format!("element `{}`", e.name())),
+                message: format!("its gear stage cannot be written: {x}"),
+            })?;
+            drop_nulls(&mut fields);
+            if let Value::Object(fields) = fields {
+                element.extend(fields);
+            }
+            elements.push(Value::Object(element));
+            continue;
+        }
         let mut law = serde_json::to_value(e.law()).map_err(|x| SceneError {
             file: file.clone(),
             position: None,

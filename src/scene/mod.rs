@@ -29,6 +29,7 @@
 
 mod dofs;
 pub mod export;
+mod gear_stage;
 mod matrix;
 pub mod matrix_market;
 
@@ -365,6 +366,19 @@ impl SceneFile {
                 Some(_) => return Err(err(&at("name"), "must be a string".into())),
                 None => format!("element {i}"),
             };
+            if e.get("type").and_then(Value::as_str) == Some("gear_stage") {
+                e.remove("type");
+                let stage = gear_stage::read(e, &name, dofs, |f| {
+                    if f.is_empty() {
+                        format!("elements[{i}]")
+                    } else {
+                        at(f)
+                    }
+                })
+                .map_err(|(path, message)| err(&path, message))?;
+                builder = builder.gear_stage(&name, stage);
+                continue;
+            }
             let connects: BTreeMap<String, f64> = match e.remove("connects") {
                 Some(v) => serde_path_to_error::deserialize(v).map_err(|x| {
                     err(
@@ -662,7 +676,7 @@ pub fn set_parameter(doc: &mut Value, path: &str, x: f64) -> Result<(), String> 
 
 /// The built-in element types (users' laws compiled in are accepted too).
 pub fn known_types() -> String {
-    "linear_spring, mesh_stiffness, backlash, cubic_spring".to_string()
+    "linear_spring, mesh_stiffness, backlash, cubic_spring, gear_stage".to_string()
 }
 
 impl Scene {
