@@ -59,11 +59,16 @@ pub struct GearStage {
     pub ratio: Option<f64>,
     /// Teeth on the driving gear z1 (>= 1).
     pub teeth: u32,
-    /// Revolutions of the driving gear per period of the fundamental (default 1): the mesh
-    /// runs `z1 · shaft_order` cycles per period, which must be a whole number (a stage behind
-    /// a ratio 2.5 under an engine-speed fundamental has `shaft_order = 0.4`).
+    /// Revolutions of the driving gear per revolution of the reference shaft (default 1): a
+    /// stage behind a ratio 2.5 from the engine has `shaft_order = 0.4`. The mesh runs
+    /// `z1 · shaft_order / f` cycles per period of a fundamental of order `f`
+    /// (`fundamental_order`), which must be a whole number.
     #[serde(default = "one")]
     pub shaft_order: f64,
+    /// The order `f` of the fundamental relative to the reference shaft (default 1; a scene
+    /// sets it from its `fundamental.order`).
+    #[serde(skip, default = "one")]
+    pub fundamental_order: f64,
     /// Mesh phase φ0, rad (default 0): `φ = z1 shaft_order θ + φ0`.
     #[serde(default)]
     pub phase: f64,
@@ -99,6 +104,7 @@ impl GearStage {
             ratio: None,
             teeth,
             shaft_order: 1.0,
+            fundamental_order: 1.0,
             phase: 0.0,
             stiffness,
             damping: MeshDamping::default(),
@@ -124,6 +130,12 @@ impl GearStage {
         self
     }
 
+    /// Sets the order of the fundamental relative to the reference shaft.
+    pub fn with_fundamental_order(mut self, order: f64) -> Self {
+        self.fundamental_order = order;
+        self
+    }
+
     /// Sets the mesh phase φ0 (rad).
     pub fn with_phase(mut self, phase: f64) -> Self {
         self.phase = phase;
@@ -145,10 +157,10 @@ impl GearStage {
         r2 / r1
     }
 
-    /// Mesh cycles per period of the fundamental, `z1 · shaft_order`, if it is a whole
+    /// Mesh cycles per period of the fundamental, `z1 · shaft_order / f`, if it is a whole
     /// number >= 1 (to 1e-9).
     pub fn mesh_order(&self) -> Option<u32> {
-        let z = self.teeth as f64 * self.shaft_order;
+        let z = self.teeth as f64 * self.shaft_order / self.fundamental_order;
         let r = z.round();
         (z.is_finite() && r >= 1.0 && r <= u32::MAX as f64 && (z - r).abs() <= 1e-9 * z.max(1.0))
             .then_some(r as u32)
@@ -179,15 +191,17 @@ impl GearStage {
             return Err(Error::invalid(context, "teeth", 0.0, "an integer >= 1"));
         }
         check_positive(context, "shaft_order", self.shaft_order)?;
+        check_positive(context, "fundamental_order", self.fundamental_order)?;
         if self.mesh_order().is_none() {
             return Err(Error::invalid(
                 context,
                 "shaft_order",
                 self.shaft_order,
                 format!(
-                    "such that teeth x shaft_order ({} x {}) is a whole number of mesh cycles \
-                     per period (choose the fundamental so that the mesh order is a harmonic)",
-                    self.teeth, self.shaft_order
+                    "such that teeth x shaft_order ({} x {}) is a whole multiple of the \
+                     fundamental's order {} (choose the fundamental so that the mesh order is a \
+                     harmonic)",
+                    self.teeth, self.shaft_order, self.fundamental_order
                 ),
             ));
         }

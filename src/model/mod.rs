@@ -9,6 +9,7 @@
 
 mod builder;
 mod element;
+pub mod engine;
 pub mod gear_stage;
 mod load;
 pub mod rigid;
@@ -16,6 +17,7 @@ mod sparse;
 
 pub use builder::ModelBuilder;
 pub use element::Element;
+pub use engine::{Cylinders, EngineExcitation, EngineOrder};
 pub use gear_stage::GearStage;
 pub use load::Load;
 pub use rigid::RigidModes;

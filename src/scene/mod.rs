@@ -29,6 +29,7 @@
 
 mod dofs;
 pub mod export;
+mod fundamental;
 mod gear_stage;
 mod matrix;
 pub mod matrix_market;
@@ -68,22 +69,6 @@ impl std::fmt::Display for SceneError {
 }
 
 impl std::error::Error for SceneError {}
-
-/// The fundamental frequency: exactly one of `rpm`, `hz`, `rad_s`, times `order` (default 1;
-/// e.g. the mesh order of a shaft speed, so that a scene models only the orders it needs).
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Fundamental {
-    rpm: Option<f64>,
-    hz: Option<f64>,
-    rad_s: Option<f64>,
-    #[serde(default = "one")]
-    order: f64,
-}
-
-fn one() -> f64 {
-    1.0
-}
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -131,8 +116,11 @@ struct SceneFile {
     damping: Option<Value>,
     #[serde(default)]
     stiffness: Option<Value>,
-    fundamental: Fundamental,
+    fundamental: fundamental::Fundamental,
     harmonics: Harmonics,
+    /// Piston-engine excitation per order and cylinder.
+    #[serde(default)]
+    engine: Option<crate::model::EngineExcitation>,
     #[serde(default)]
     loads: Vec<LoadSpec>,
     #[serde(default)]
@@ -345,6 +333,34 @@ impl SceneFile {
         let known: std::collections::HashSet<&str> =
             dofs.names.iter().map(String::as_str).collect();
         let mut builder = structure.builder();
+        let speed = self
+            .fundamental
+            .speed(self.engine.as_ref(), &self.elements)
+            .map_err(|(path, message)| err(&path, message))?;
+        if let Some(engine) = &self.engine {
+            for (i, dof) in engine.cylinder_dofs().iter().enumerate() {
+                if !known.contains(dof.as_str()) {
+                    let path = match engine.cylinders {
+                        crate::model::Cylinders::Count(_) => "engine.dof".to_string(),
+                        crate::model::Cylinders::Dofs(_) => format!("engine.cylinders[{i}]"),
+                    };
+                    let message = format!("unknown DOF `{dof}` (the scene has: {})", dofs.listing());
+                    return Err(err(&path, message));
+                }
+            }
+            let loads = engine
+                .validate("engine")
+                .and_then(|()| engine.loads(speed.order))
+                .map_err(|e| match &e {
+                    crate::Error::InvalidParameter { name, .. } => {
+                        err(&format!("engine.{name}"), e.to_string())
+                    }
+                    _ => err("engine", e.to_string()),
+                })?;
+            for (dof, k, c, s) in loads {
+                builder = builder.load(&dof, k, c, s);
+            }
+        }
         for (i, l) in self.loads.iter().enumerate() {
             if !known.contains(l.dof.as_str()) {
                 return Err(err(
@@ -376,7 +392,7 @@ impl SceneFile {
                     }
                 })
                 .map_err(|(path, message)| err(&path, message))?;
-                builder = builder.gear_stage(&name, stage);
+                builder = builder.gear_stage(&name, stage.with_fundamental_order(speed.order));
                 continue;
             }
             let connects: BTreeMap<String, f64> = match e.remove("connects") {
@@ -454,35 +470,7 @@ impl SceneFile {
             err(&path, message)
         })?;
 
-        let f = &self.fundamental;
-        let given: Vec<(&str, f64)> = [("rpm", f.rpm), ("hz", f.hz), ("rad_s", f.rad_s)]
-            .into_iter()
-            .filter_map(|(k, v)| v.map(|v| (k, v)))
-            .collect();
-        let (speed_unit, per_unit, omega) = match given.as_slice() {
-            [("rpm", v)] => ("rpm", std::f64::consts::TAU / 60.0, *v),
-            [("hz", v)] => ("hz", std::f64::consts::TAU, *v),
-            [(_, v)] => ("rad_s", 1.0, *v),
-            _ => {
-                return Err(err(
-                    "fundamental",
-                    "give exactly one of `rpm`, `hz`, `rad_s`".into(),
-                ))
-            }
-        };
-        if !(f.order.is_finite() && f.order > 0.0) {
-            return Err(err(
-                "fundamental.order",
-                format!("must be finite and > 0, got {}", f.order),
-            ));
-        }
-        let omega = omega * per_unit * f.order;
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(err(
-                "fundamental",
-                format!("must be finite and > 0, got {omega} rad/s"),
-            ));
-        }
+        let omega = speed.omega;
         let hs = &self.harmonics;
         let auto = if hs.auto {
             let defaults = crate::solve::AutoHarmonics::default();
@@ -566,8 +554,8 @@ impl SceneFile {
             basis,
             auto,
             method,
-            speed_unit,
-            omega_per_speed: per_unit * f.order,
+            speed_unit: speed.unit,
+            omega_per_speed: speed.per_unit * speed.order,
             solver: self.solver,
         })
     }
