@@ -238,7 +238,7 @@ fn bad_gear_stages_name_the_element_and_field() {
             "teeth = 2",
             "teeth = 2\nshaft_order = 0.3",
             "elements[0].shaft_order",
-            "whole number",
+            "whole multiple",
         ),
         ("teeth = 2", "teeth = 0", "elements[0].teeth", ">= 1"),
         (
