@@ -95,3 +95,46 @@ fn stop_spring_matches_the_time_domain() {
     eprintln!("stop_spring: {e:.2e}");
     assert!(e < 1e-4, "{e:e}");
 }
+
+/// `gap_contact` with a time-varying stiffness `k(θ) = 5 + cos 2θ`, contact damping (the
+/// force jumps at the contact edge) and an element offset, in Rust: against the time domain.
+#[test]
+fn gap_contact_with_offset_and_damping_matches_the_time_domain() {
+    use hbal::force::{GapContact, MeshProfile, Offset};
+    let contact = GapContact::with_profile(
+        0.5,
+        MeshProfile::Cosine {
+            mean: 5.0,
+            amplitude: 1.0,
+        },
+    )
+    .with_teeth(2)
+    .with_contact_damping(0.2);
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .damping(hbal::nalgebra::DMatrix::from_element(1, 1, 0.1))
+        .stiffness(hbal::nalgebra::DMatrix::from_element(1, 1, 1.0))
+        .element("stop", &[("x", 1.0)], Offset::new(0.3, contact))
+        .load("x", 0, 0.2, 0.0)
+        .load("x", 1, 1.0, 0.0)
+        .build()
+        .unwrap();
+    let omega = 1.1;
+    let errors: Vec<f64> = [32, 64]
+        .iter()
+        .map(|&h| error_against_time_domain(&model, omega, h))
+        .collect();
+    eprintln!("gap_contact: {errors:?}");
+    // In contact part of the period (the edge is at x = 0.8).
+    let x = hb(&model, omega, 64);
+    let peak = (0..64)
+        .map(|j| {
+            let t = std::f64::consts::TAU * j as f64 / 64.0;
+            (0..=64)
+                .map(|k| (x[k] * Complex64::from_polar(1.0, k as f64 * t)).re)
+                .sum::<f64>()
+        })
+        .fold(f64::MIN, f64::max);
+    assert!(peak > 0.9, "{peak}");
+    assert!(errors[1] < 1e-4 && errors[1] < errors[0], "{errors:?}");
+}
