@@ -63,17 +63,35 @@ fn laws() -> Vec<Box<dyn ForceLaw>> {
         ),
         Box::new(GapContact::new(-0.2, 5.0)),
         Box::new(StopSpring::new(vec![
-            Stage { from: 0.2, stiffness: 1.0 },
-            Stage { from: 1.0, stiffness: 4.0 },
-            Stage { from: 2.0, stiffness: 9.0 },
+            Stage {
+                from: 0.2,
+                stiffness: 1.0,
+            },
+            Stage {
+                from: 1.0,
+                stiffness: 4.0,
+            },
+            Stage {
+                from: 2.0,
+                stiffness: 9.0,
+            },
         ])),
         Box::new(
-            StopSpring::new(vec![Stage { from: 0.0, stiffness: 2.0 }])
-                .with_negative(vec![
-                    Stage { from: 0.3, stiffness: 0.5 },
-                    Stage { from: 1.5, stiffness: 7.0 },
-                ])
-                .with_damping(0.4),
+            StopSpring::new(vec![Stage {
+                from: 0.0,
+                stiffness: 2.0,
+            }])
+            .with_negative(vec![
+                Stage {
+                    from: 0.3,
+                    stiffness: 0.5,
+                },
+                Stage {
+                    from: 1.5,
+                    stiffness: 7.0,
+                },
+            ])
+            .with_damping(0.4),
         ),
         Box::new(Friction::new(1.5, 0.5)),
         Box::new(QuadraticDamper::new(0.8)),
@@ -246,7 +264,10 @@ fn gap_contact_is_one_sided() {
     assert_eq!((lin.stiffness, lin.offset), (100.0, 1.0));
     assert_eq!(pre.force(0.0, 0.0, 0.0), 1.0);
     let forced = c.clone().with_linearize(ContactState::Closed).linear_part();
-    assert_eq!((forced.stiffness, forced.damping, forced.offset), (100.0, 0.5, -100.0));
+    assert_eq!(
+        (forced.stiffness, forced.damping, forced.offset),
+        (100.0, 0.5, -100.0)
+    );
     let open = pre.with_linearize(ContactState::Open).linear_part();
     assert_eq!(open.stiffness, 0.0);
     // A time-varying stiffness declares its order; a constant one does not.
@@ -275,10 +296,19 @@ fn gap_contact_is_one_sided() {
 #[test]
 fn stop_spring_stages_and_sides() {
     let s = StopSpring::new(vec![
-        Stage { from: 0.1, stiffness: 50.0 },
-        Stage { from: 0.3, stiffness: 400.0 },
+        Stage {
+            from: 0.1,
+            stiffness: 50.0,
+        },
+        Stage {
+            from: 0.3,
+            stiffness: 400.0,
+        },
     ])
-    .with_negative(vec![Stage { from: 0.2, stiffness: 80.0 }]);
+    .with_negative(vec![Stage {
+        from: 0.2,
+        stiffness: 80.0,
+    }]);
     // Continuous through every stage start, free play around 0.
     for (u, f) in [
         (0.05, 0.0),
@@ -299,9 +329,21 @@ fn stop_spring_stages_and_sides() {
     assert_eq!(s.kinks(), vec![-0.2, 0.1, 0.3]);
     assert_eq!(s.linear_part().stiffness, 65.0);
     // Both sides engaged from 0: one kink there unless the stiffnesses agree.
-    let odd = StopSpring::new(vec![Stage { from: 0.0, stiffness: 2.0 }, Stage { from: 1.0, stiffness: 3.0 }]);
+    let odd = StopSpring::new(vec![
+        Stage {
+            from: 0.0,
+            stiffness: 2.0,
+        },
+        Stage {
+            from: 1.0,
+            stiffness: 3.0,
+        },
+    ]);
     assert_eq!(odd.kinks(), vec![-1.0, 1.0]);
-    let bent = odd.clone().with_negative(vec![Stage { from: 0.0, stiffness: 1.0 }]);
+    let bent = odd.clone().with_negative(vec![Stage {
+        from: 0.0,
+        stiffness: 1.0,
+    }]);
     assert_eq!(bent.kinks(), vec![0.0, 1.0]);
 }
 
@@ -334,7 +376,10 @@ fn offset_shifts_the_law_and_everything_it_declares() {
     let shifted = Offset::new(0.5, inner.clone());
     for &(t, u, v) in &[(0.1, 0.9, 0.3), (2.0, 0.2, -1.0), (4.0, 0.45, 2.0)] {
         assert_eq!(shifted.force(t, u, v), inner.force(t, u - 0.5, v));
-        assert_eq!(shifted.derivatives(t, u, v), inner.derivatives(t, u - 0.5, v));
+        assert_eq!(
+            shifted.derivatives(t, u, v),
+            inner.derivatives(t, u - 0.5, v)
+        );
     }
     assert_eq!(shifted.kinks(), vec![0.4, 0.6]);
     let (a, b) = (inner.linear_part(), shifted.linear_part());
@@ -343,10 +388,15 @@ fn offset_shifts_the_law_and_everything_it_declares() {
     assert_eq!(shifted.time_breakpoints(), inner.time_breakpoints());
     assert_eq!(shifted.time_order(), Some(3));
     // The band-limited copy keeps the offset.
-    let band = shifted.band_limited(64, 10).expect("a jumping profile is band-limited");
+    let band = shifted
+        .band_limited(64, 10)
+        .expect("a jumping profile is band-limited");
     let inner_band = inner.band_limited(64, 10).unwrap();
     let theta = std::f64::consts::TAU * 5.0 / 64.0;
-    assert_eq!(band.force(theta, 0.9, 0.0), inner_band.force(theta, 0.4, 0.0));
+    assert_eq!(
+        band.force(theta, 0.9, 0.0),
+        inner_band.force(theta, 0.4, 0.0)
+    );
     // A linear spring stays linear time-invariant, with the static force in its offset.
     let spring = Offset::new(0.02, LinearSpring::new(100.0, 1.0));
     assert!(spring.is_linear_time_invariant());
@@ -356,5 +406,8 @@ fn offset_shifts_the_law_and_everything_it_declares() {
         .validate("element `s`")
         .unwrap_err()
         .to_string();
-    assert!(err.contains("element `s`: parameter `offset` must be finite"), "{err}");
+    assert!(
+        err.contains("element `s`: parameter `offset` must be finite"),
+        "{err}"
+    );
 }

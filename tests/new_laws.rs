@@ -12,14 +12,20 @@ use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
 use std::path::Path;
 
 fn scene(name: &str) -> Scene {
-    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes").join(name))
-        .unwrap()
+    Scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/scenes")
+            .join(name),
+    )
+    .unwrap()
 }
 
 /// The state `(q, q̇)` at θ = 0 of harmonics `x` (harmonic-major, `n` DOFs, fundamental ω).
 fn state_at_zero(x: &[Complex64], n: usize, omega: f64) -> (Vec<f64>, Vec<f64>) {
     let h = x.len() / n - 1;
-    let q = (0..n).map(|i| (0..=h).map(|k| x[k * n + i].re).sum()).collect();
+    let q = (0..n)
+        .map(|i| (0..=h).map(|k| x[k * n + i].re).sum())
+        .collect();
     let v = (0..n)
         .map(|i| {
             (1..=h)

@@ -39,7 +39,9 @@ fn refine(model: &Model, p: &BranchPoint, h: usize) -> Vec<Complex64> {
 fn time_domain(model: &Model, omega: f64, x: &[Complex64]) -> Vec<Complex64> {
     let n = model.n_dofs();
     let h = x.len() / n - 1;
-    let q = (0..n).map(|i| (0..=h).map(|k| x[k * n + i].re).sum()).collect();
+    let q = (0..n)
+        .map(|i| (0..=h).map(|k| x[k * n + i].re).sum())
+        .collect();
     let v = (0..n)
         .map(|i| {
             (1..=h)
@@ -79,7 +81,11 @@ fn frequency_response_turns_twice_and_matches_the_time_domain() {
     assert!((folds[0] - 0.6535).abs() < 5e-4, "{folds:?}");
     assert!((folds[1] - 0.75563).abs() < 1e-4, "{folds:?}");
     // The peak: the first mass well beyond the gap.
-    let peak = branch.points.iter().map(|p| p.max_abs[0]).fold(0.0, f64::max);
+    let peak = branch
+        .points
+        .iter()
+        .map(|p| p.max_abs[0])
+        .fold(0.0, f64::max);
     eprintln!("peak max |q1| {peak}");
     assert!(peak > 1.8 && peak < 1.9, "{peak}");
 
@@ -115,7 +121,10 @@ fn frequency_response_turns_twice_and_matches_the_time_domain() {
         let td = time_domain(&s.model, p.omega, &x);
         let e = relative_error(&x, &td, n, 256);
         let h21 = relative_error(&p.harmonics, &td, n, 256);
-        eprintln!("Ω {:.4}: H = 128 error {e:.2e}, H = 21 error {h21:.2e}", p.omega);
+        eprintln!(
+            "Ω {:.4}: H = 128 error {e:.2e}, H = 21 error {h21:.2e}",
+            p.omega
+        );
         assert!(e < 1e-4, "Ω {}: {e:e}", p.omega);
     }
 }

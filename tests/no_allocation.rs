@@ -139,8 +139,14 @@ fn new_laws_and_offsets_do_not_allocate_per_iteration() {
             "stages",
             &[("a", 1.0), ("b", -1.0)],
             StopSpring::new(vec![
-                Stage { from: 0.1, stiffness: 1.0 },
-                Stage { from: 0.4, stiffness: 3.0 },
+                Stage {
+                    from: 0.1,
+                    stiffness: 1.0,
+                },
+                Stage {
+                    from: 0.4,
+                    stiffness: 3.0,
+                },
             ]),
         )
         .element("friction", &[("b", 1.0)], Friction::new(0.05, 0.2))

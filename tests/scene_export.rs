@@ -88,7 +88,11 @@ fn elements_with_an_offset_round_trip() {
     let model = Model::builder(&["a", "b"])
         .mass_diagonal(&[1.0, 0.5])
         .damping(hbal::nalgebra::DMatrix::from_diagonal_element(2, 2, 0.05))
-        .element("shaft", &[("a", 1.0), ("b", -1.0)], LinearSpring::new(2.0, 0.0))
+        .element(
+            "shaft",
+            &[("a", 1.0), ("b", -1.0)],
+            LinearSpring::new(2.0, 0.0),
+        )
         .element(
             "preloaded",
             &[("b", 1.0)],
@@ -118,7 +122,12 @@ fn elements_with_an_offset_round_trip() {
         .unwrap();
     let dir = std::env::temp_dir().join(format!("hbal-export-offset-{}", std::process::id()));
     let file = dir.join("offsets.toml");
-    write_scene(&model, &SceneSettings::new("offsets", "rad_s", 1.3, 24), &file).unwrap();
+    write_scene(
+        &model,
+        &SceneSettings::new("offsets", "rad_s", 1.3, 24),
+        &file,
+    )
+    .unwrap();
     let text = std::fs::read_to_string(&file).unwrap();
     let scene = Scene::load(&file).unwrap();
     std::fs::remove_dir_all(&dir).ok();

@@ -35,7 +35,11 @@ impl PolynomialSpring {
 impl ForceLaw for PolynomialSpring {
     #[inline]
     fn force(&self, _theta: f64, u: f64, _du: f64) -> f64 {
-        u * self.coefficients.iter().rev().fold(0.0, |acc, c| c + u * acc)
+        u * self
+            .coefficients
+            .iter()
+            .rev()
+            .fold(0.0, |acc, c| c + u * acc)
     }
     #[inline]
     fn derivatives(&self, _theta: f64, u: f64, _du: f64) -> (f64, f64) {

@@ -127,7 +127,11 @@ fn validate_side(context: &str, field: &str, stages: &[Stage]) -> Result<()> {
                     context,
                     format!("{field}[{i}].from"),
                     s.from,
-                    format!("> {field}[{}].from = {} (stages by increasing `from`)", i - 1, before.from),
+                    format!(
+                        "> {field}[{}].from = {} (stages by increasing `from`)",
+                        i - 1,
+                        before.from
+                    ),
                 ));
             }
             if s.stiffness < before.stiffness {
