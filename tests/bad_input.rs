@@ -149,6 +149,98 @@ fn model_errors_name_the_place() {
     }
 }
 
+/// The new laws and the element offset: every bad parameter names the element and the field.
+#[test]
+fn new_law_errors_name_element_and_field() {
+    use hbal::force::{
+        ForceLaw, Friction, GapContact, Offset, PolynomialSpring, QuadraticDamper, Stage,
+        StopSpring,
+    };
+    let build = |law: Box<dyn ForceLaw>| {
+        Model::builder(&["a"])
+            .mass_diagonal(&[1.0])
+            .element_boxed("el", &[("a", 1.0)], law)
+            .build()
+    };
+    let stage = |from, stiffness| Stage { from, stiffness };
+    let cases: Vec<(Box<dyn ForceLaw>, &str)> = vec![
+        (
+            Box::new(Offset::new(f64::NAN, GapContact::new(0.0, 1.0))),
+            "element `el`: parameter `offset` must be finite, got NaN",
+        ),
+        (
+            Box::new(Offset::new(0.1, GapContact::new(f64::INFINITY, 1.0))),
+            "element `el`: parameter `gap` must be finite, got inf",
+        ),
+        (
+            Box::new(GapContact::new(0.0, -1.0)),
+            "element `el`: parameter `stiffness` must be finite and >= 0",
+        ),
+        (
+            Box::new(GapContact::new(0.0, 1.0).with_contact_damping(-0.1)),
+            "element `el`: parameter `contact_damping` must be finite and >= 0",
+        ),
+        (
+            Box::new(GapContact::new(0.0, 1.0).with_teeth(0)),
+            "element `el`: parameter `teeth` must be an integer >= 1",
+        ),
+        (
+            Box::new(StopSpring::new(vec![])),
+            "element `el`: parameter `stages` must be a non-empty list",
+        ),
+        (
+            Box::new(StopSpring::new(vec![stage(0.0, 400.0), stage(0.3, 50.0)])),
+            "element `el`: parameter `stages[1].stiffness` must be >= stages[0].stiffness = 400 (a progressive spring",
+        ),
+        (
+            Box::new(StopSpring::new(vec![stage(0.2, 1.0), stage(0.2, 2.0)])),
+            "element `el`: parameter `stages[1].from` must be > stages[0].from = 0.2",
+        ),
+        (
+            Box::new(StopSpring::new(vec![stage(-0.1, 1.0)])),
+            "element `el`: parameter `stages[0].from` must be finite and >= 0, got -0.1",
+        ),
+        (
+            Box::new(
+                StopSpring::new(vec![stage(0.0, 1.0)])
+                    .with_negative(vec![stage(0.0, 5.0), stage(0.1, 2.0)]),
+            ),
+            "element `el`: parameter `negative[1].stiffness` must be >= negative[0].stiffness = 5",
+        ),
+        (
+            Box::new(StopSpring::new(vec![stage(0.0, 1.0)]).with_damping(-1.0)),
+            "element `el`: parameter `damping` must be finite and >= 0",
+        ),
+        (
+            Box::new(Friction::new(-0.5, 0.1)),
+            "element `el`: parameter `limit` must be finite and >= 0, got -0.5",
+        ),
+        (
+            Box::new(Friction::new(0.5, 0.0)),
+            "element `el`: parameter `regularization` must be finite and > 0, got 0",
+        ),
+        (
+            Box::new(QuadraticDamper::new(-2.0)),
+            "element `el`: parameter `c` must be finite and >= 0",
+        ),
+        (
+            Box::new(PolynomialSpring::new(vec![])),
+            "element `el`: parameter `coefficients` must be a non-empty list",
+        ),
+        (
+            Box::new(PolynomialSpring::new(vec![1.0, f64::NAN])),
+            "element `el`: parameter `coefficients[1]` must be finite, got NaN",
+        ),
+    ];
+    for (law, expected) in cases {
+        let msg = message(build(law));
+        assert!(
+            msg.contains(expected),
+            "`{msg}` does not contain `{expected}`"
+        );
+    }
+}
+
 #[test]
 fn discretisation_errors() {
     assert!(matches!(

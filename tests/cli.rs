@@ -242,6 +242,41 @@ fn broken_scenes_give_messages_that_name_file_and_field() {
         ("no_connects.toml", GOOD.replace("connects = { x = 1.0 }", ""), "elements[0]: missing field `connects`"),
         ("no_type.toml", GOOD.replace("type = \"linear_spring\"", ""), "elements[0]: missing field `type`"),
         (
+            "gap_nan.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"gap_contact\"")
+                .replace("k = 1.0", "gap = nan\nstiffness = 100.0"),
+            "elements[0].gap: must be a finite number, got NaN",
+        ),
+        ("offset_inf.toml", GOOD.replace("k = 1.0", "k = 1.0\noffset = -inf"), "elements[0].offset: must be a finite number, got -inf"),
+        ("offset_type.toml", GOOD.replace("k = 1.0", "k = 1.0\noffset = \"1 mm\""), "elements[0].offset: must be a number (m or rad)"),
+        ("offset_as_type.toml", GOOD.replace("type = \"linear_spring\"", "type = \"offset\""), "elements[0].type: `offset` is not an element type"),
+        (
+            "stages.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"stop_spring\"").replace(
+                "k = 1.0",
+                "stages = [{ from = 0.0, stiffness = 400.0 }, { from = 0.3, stiffness = 50.0 }]",
+            ),
+            "element `spring`: parameter `stages[1].stiffness` must be >= stages[0].stiffness = 400 (a progressive spring",
+        ),
+        (
+            "stage_field.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"stop_spring\"")
+                .replace("k = 1.0", "stages = [{ from = 0.0, stifness = 400.0 }]"),
+            "unknown field `stifness`",
+        ),
+        (
+            "friction_limit.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"friction\"")
+                .replace("k = 1.0", "limit = -1.0\nregularization = 0.01"),
+            "element `spring`: parameter `limit` must be finite and >= 0, got -1",
+        ),
+        (
+            "polynomial_empty.toml",
+            GOOD.replace("type = \"linear_spring\"", "type = \"polynomial_spring\"")
+                .replace("k = 1.0", "coefficients = []"),
+            "element `spring`: parameter `coefficients` must be a non-empty list",
+        ),
+        (
             "resonance.toml",
             GOOD.replace("damping = [[0.1]]", "").replace("{ rad_s = 1.3 }", "{ rad_s = 0.5 }"),
             "singular at harmonic 2",

@@ -112,3 +112,71 @@ fn anderson_and_newton_iterations_do_not_allocate() {
         );
     }
 }
+
+/// The new laws and an element offset (whose batch calls shift the coordinate through a stack
+/// buffer): Newton's allocations per solve do not depend on the number of iterations.
+#[test]
+fn new_laws_and_offsets_do_not_allocate_per_iteration() {
+    use hbal::force::{
+        Friction, GapContact, MeshProfile, Offset, PolynomialSpring, QuadraticDamper, Stage,
+        StopSpring,
+    };
+    let contact = GapContact::with_profile(
+        0.3,
+        MeshProfile::Rectangular {
+            one_tooth: 4.0,
+            two_tooth: 6.0,
+            contact_ratio: 1.4,
+        },
+    )
+    .with_contact_damping(0.1);
+    let model = hbal::Model::builder(&["a", "b"])
+        .mass_diagonal(&[1.0, 2.0])
+        .damping(hbal::nalgebra::DMatrix::from_diagonal_element(2, 2, 0.1))
+        .stiffness(hbal::nalgebra::DMatrix::from_diagonal_element(2, 2, 1.0))
+        .element("contact", &[("a", 1.0)], Offset::new(0.2, contact))
+        .element(
+            "stages",
+            &[("a", 1.0), ("b", -1.0)],
+            StopSpring::new(vec![
+                Stage {
+                    from: 0.1,
+                    stiffness: 1.0,
+                },
+                Stage {
+                    from: 0.4,
+                    stiffness: 3.0,
+                },
+            ]),
+        )
+        .element("friction", &[("b", 1.0)], Friction::new(0.05, 0.2))
+        .element("damper", &[("b", 1.0)], QuadraticDamper::new(0.1))
+        .element(
+            "poly",
+            &[("b", 1.0)],
+            Offset::new(-0.1, PolynomialSpring::new(vec![0.5, 0.2, 0.1])),
+        )
+        .load("a", 1, 0.8, 0.0)
+        .build()
+        .unwrap();
+    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(1.1, 16).unwrap()).unwrap();
+    let mut ws = hb.workspace();
+    let newton = |iterations: usize| {
+        hbal::Method::Newton(
+            hbal::Newton::new()
+                .with_tolerance(0.0)
+                .unwrap()
+                .with_max_iterations(iterations),
+        )
+    };
+    let _ = newton(2).solve(&hb, None, &mut ws);
+    let mut count = |iterations: usize| {
+        let before = allocations();
+        let sol = newton(iterations).solve(&hb, None, &mut ws).unwrap();
+        (allocations() - before, sol.stats.iterations)
+    };
+    let (few, it_few) = count(2);
+    let (many, it_many) = count(8);
+    assert!(it_many > it_few, "{it_few} and {it_many} iterations");
+    assert_eq!(few, many, "allocations grow with iterations");
+}

@@ -79,3 +79,74 @@ fn an_unwritable_target_names_the_file() {
         "{text}"
     );
 }
+
+/// Elements with an offset are written as their law's fields plus `offset` and read back to
+/// the same laws and the same solution.
+#[test]
+fn elements_with_an_offset_round_trip() {
+    use hbal::force::{GapContact, LinearSpring, Offset, Stage, StopSpring};
+    let model = Model::builder(&["a", "b"])
+        .mass_diagonal(&[1.0, 0.5])
+        .damping(hbal::nalgebra::DMatrix::from_diagonal_element(2, 2, 0.05))
+        .element(
+            "shaft",
+            &[("a", 1.0), ("b", -1.0)],
+            LinearSpring::new(2.0, 0.0),
+        )
+        .element(
+            "preloaded",
+            &[("b", 1.0)],
+            Offset::new(-0.02, LinearSpring::new(3.0, 0.1)),
+        )
+        .element(
+            "stop",
+            &[("a", 1.0)],
+            Offset::new(0.25, GapContact::new(0.5, 40.0).with_contact_damping(0.2)),
+        )
+        .element(
+            "twice",
+            &[("a", -1.0)],
+            Offset::new(
+                0.5,
+                Offset::new(
+                    0.25,
+                    StopSpring::new(vec![Stage {
+                        from: 0.1,
+                        stiffness: 5.0,
+                    }]),
+                ),
+            ),
+        )
+        .load("a", 1, 1.5, 0.0)
+        .build()
+        .unwrap();
+    let dir = std::env::temp_dir().join(format!("hbal-export-offset-{}", std::process::id()));
+    let file = dir.join("offsets.toml");
+    write_scene(
+        &model,
+        &SceneSettings::new("offsets", "rad_s", 1.3, 24),
+        &file,
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    let scene = Scene::load(&file).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(text.matches("offset = ").count(), 3, "{text}");
+    assert!(!text.contains("law"), "{text}");
+    for (a, b) in scene.model.elements().iter().zip(model.elements()) {
+        assert_eq!(a.linear_part(), b.linear_part(), "{}", a.name());
+        assert_eq!(a.law().kinks(), b.law().kinks(), "{}", a.name());
+        for u in [-1.0, -0.3, 0.1, 0.6, 0.8, 1.2] {
+            assert_eq!(
+                a.law().force(0.3, u, 0.4),
+                b.law().force(0.3, u, 0.4),
+                "{} at {u}",
+                a.name()
+            );
+        }
+    }
+    let basis = HarmonicBasis::new(1.3, 24).unwrap();
+    let (a, b) = (solve(&scene.model, basis), solve(&model, basis));
+    assert!(relative_error(a.harmonics(), b.harmonics(), 2, 24) < 1e-12);
+    assert!(a.max_abs(0) > 0.75, "{}", a.max_abs(0)); // in contact with the stop at 0.75
+}

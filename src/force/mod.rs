@@ -11,22 +11,38 @@
 //!
 //! Built-in laws (scene-file names in brackets): [`LinearSpring`] (`linear_spring`),
 //! [`MeshStiffness`] (`mesh_stiffness`), [`Backlash`] (`backlash`), [`CubicSpring`]
-//! (`cubic_spring`). Implement [`ForceLaw`] in your own crate for anything else and check its
-//! derivatives with [`check_derivatives`].
+//! (`cubic_spring`), [`GapContact`] (`gap_contact`), [`StopSpring`] (`stop_spring`),
+//! [`Friction`] (`friction`), [`QuadraticDamper`] (`quadratic_damper`),
+//! [`PolynomialSpring`] (`polynomial_spring`). Any law acts on a shifted coordinate
+//! `u - u0` through [`Offset`] (the element field `offset` in a scene file). Implement
+//! [`ForceLaw`] in your own crate for anything else and check its derivatives with
+//! [`check_derivatives`].
 
 mod backlash;
 mod check;
 mod cubic_spring;
+mod friction;
+mod gap_contact;
 mod linear_spring;
 mod mesh_stiffness;
+mod offset;
+mod polynomial_spring;
 mod profile;
+mod quadratic_damper;
+mod stop_spring;
 
 pub use backlash::{Backlash, Flank};
 pub use check::{check_derivatives, DerivativeCheck};
 pub use cubic_spring::CubicSpring;
+pub use friction::Friction;
+pub use gap_contact::{ContactState, GapContact};
 pub use linear_spring::LinearSpring;
 pub use mesh_stiffness::MeshStiffness;
+pub use offset::Offset;
+pub use polynomial_spring::PolynomialSpring;
 pub use profile::{MeshDamping, MeshProfile};
+pub use quadratic_damper::QuadraticDamper;
+pub use stop_spring::{Stage, StopSpring};
 
 use crate::Result;
 use std::f64::consts::TAU;
@@ -55,19 +71,19 @@ pub struct LinearPart {
 /// ```
 /// use hbal::force::ForceLaw;
 ///
-/// /// A quadratic damper `f = c u̇ |u̇|`.
+/// /// A cubic damper `f = c u̇³`.
 /// #[derive(Debug, serde::Serialize, serde::Deserialize)]
-/// struct QuadraticDamper { c: f64 }
+/// struct CubicDamper { c: f64 }
 ///
-/// #[typetag::serde(name = "quadratic_damper")]
-/// impl ForceLaw for QuadraticDamper {
-///     fn force(&self, _theta: f64, _u: f64, du: f64) -> f64 { self.c * du * du.abs() }
+/// #[typetag::serde(name = "cubic_damper")]
+/// impl ForceLaw for CubicDamper {
+///     fn force(&self, _theta: f64, _u: f64, du: f64) -> f64 { self.c * du * du * du }
 ///     fn derivatives(&self, _theta: f64, _u: f64, du: f64) -> (f64, f64) {
-///         (0.0, 2.0 * self.c * du.abs())
+///         (0.0, 3.0 * self.c * du * du)
 ///     }
 /// }
-/// let law = QuadraticDamper { c: 2.0 };
-/// assert_eq!(law.force(0.0, 0.0, -3.0), -18.0);
+/// let law = CubicDamper { c: 2.0 };
+/// assert_eq!(law.force(0.0, 0.0, -3.0), -54.0);
 /// let check = hbal::force::check_derivatives(&law, &[(0.3, 0.1, 0.7)]);
 /// assert!(check.max_relative_error < 1e-6);
 /// ```

@@ -173,6 +173,7 @@ pub fn write_scene(model: &Model, settings: &SceneSettings, path: &Path) -> Resu
             message: format!("its law cannot be written: {x}"),
         })?;
         drop_nulls(&mut law);
+        flatten_offset(&mut law);
         let mut element = Map::new();
         element.insert("name".into(), json!(e.name()));
         let connects: Map<String, Value> = e
@@ -192,6 +193,24 @@ pub fn write_scene(model: &Model, settings: &SceneSettings, path: &Path) -> Resu
         "# Written by hbal (scene::export): the model's matrices and DOF names are in the\n\
                   # directory next to this file.\n";
     std::fs::write(path, format!("{header}{text}")).map_err(|e| fail(path, &e))
+}
+
+/// Writes an [`Offset`](crate::force::Offset) law as a scene file has it: the inner law's
+/// fields and `offset = u0` (nested offsets summed).
+fn flatten_offset(law: &mut Value) {
+    let mut u0 = 0.0;
+    let mut shifted = false;
+    while law.get("type").and_then(Value::as_str) == Some("offset") {
+        let Some(inner) = law.get_mut("law").map(Value::take) else {
+            return;
+        };
+        u0 += law.get("offset").and_then(Value::as_f64).unwrap_or(0.0);
+        shifted = true;
+        *law = inner;
+    }
+    if let (true, Value::Object(fields)) = (shifted, law) {
+        fields.insert("offset".into(), json!(u0));
+    }
 }
 
 /// Removes `null` fields (unset options), which TOML cannot hold.

@@ -417,6 +417,28 @@ impl SceneFile {
                     ));
                 }
             }
+            // `offset = u0` on any element: the law on `u - u0` (removed before the law's own
+            // fields are read; a law's own field may not be called `offset`).
+            let offset = match e.remove("offset") {
+                Some(v) => match v.as_f64() {
+                    Some(x) => Some(x),
+                    None => {
+                        return Err(err(
+                            &at("offset"),
+                            format!("must be a number (m or rad), got {v}"),
+                        ))
+                    }
+                },
+                None => None,
+            };
+            if e.get("type").and_then(|t| t.as_str()) == Some("offset") {
+                return Err(err(
+                    &at("type"),
+                    "`offset` is not an element type: give the law's own `type` and the \
+                     field `offset = u0` next to it"
+                        .into(),
+                ));
+            }
             if !e.contains_key("type") {
                 return Err(err(
                     &format!("elements[{i}]"),
@@ -461,6 +483,10 @@ impl SceneFile {
                     }
                     err(&path, message)
                 })?;
+            let law = match offset {
+                Some(u0) => Box::new(crate::force::Offset::boxed(u0, law)),
+                None => law,
+            };
             let weights: Vec<(&str, f64)> =
                 connects.iter().map(|(d, w)| (d.as_str(), *w)).collect();
             builder = builder.element_boxed(&name, &weights, law);
@@ -664,7 +690,9 @@ pub fn set_parameter(doc: &mut Value, path: &str, x: f64) -> Result<(), String> 
 
 /// The built-in element types (users' laws compiled in are accepted too).
 pub fn known_types() -> String {
-    "linear_spring, mesh_stiffness, backlash, cubic_spring, gear_stage".to_string()
+    "linear_spring, mesh_stiffness, backlash, cubic_spring, gap_contact, stop_spring, friction, \
+     quadratic_damper, polynomial_spring, gear_stage"
+        .to_string()
 }
 
 impl Scene {
