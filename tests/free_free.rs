@@ -206,7 +206,7 @@ fn cli_rejects_an_unbalanced_scene_with_exit_code_2() {
         "/examples/scenes/free_free_drivetrain.toml"
     );
     let text = std::fs::read_to_string(scene).unwrap();
-    let marker = "# load torque";
+    let marker = "road load torque";
     let line = text.lines().find(|l| l.contains(marker)).unwrap();
     let bad = text.replace(line, "  { dof = \"vehicle\", order = 0, cos = 1.0 },");
     let dir = std::env::temp_dir().join(format!("hbal-free-free-{}", std::process::id()));

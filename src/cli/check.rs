@@ -11,11 +11,14 @@ pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
     HarmonicBalance::with_formulation(&scene.model, scene.basis, hbal::Formulation::Auto)
         .with_context(|| scene.file.clone())?;
     say!(
-        "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s, H = {}, N = {}, solver {})",
+        "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s (order {} of the {} speed), H = {}, \
+         N = {}, solver {})",
         scene.file,
         scene.model.n_dofs(),
         scene.model.elements().len(),
         scene.basis.omega(),
+        scene.fundamental_order,
+        scene.speed_unit,
         scene.basis.harmonics(),
         scene.basis.samples(),
         scene.method.name()

@@ -150,6 +150,9 @@ pub struct Scene {
     pub speed_unit: &'static str,
     /// Fundamental Ω (rad/s) per unit of speed (includes `order`).
     pub omega_per_speed: f64,
+    /// The fundamental's order relative to the scene's speed (`fundamental.order`, or chosen
+    /// from the engine and mesh orders: 0.5 with half orders).
+    pub fundamental_order: f64,
     solver: SolverSpec,
 }
 
@@ -338,25 +341,25 @@ impl SceneFile {
             .speed(self.engine.as_ref(), &self.elements)
             .map_err(|(path, message)| err(&path, message))?;
         if let Some(engine) = &self.engine {
+            let engine_err = |e: crate::Error| match &e {
+                crate::Error::InvalidParameter { name, .. } => {
+                    err(&format!("engine.{name}"), e.to_string())
+                }
+                _ => err("engine", e.to_string()),
+            };
+            engine.validate("engine").map_err(engine_err)?;
             for (i, dof) in engine.cylinder_dofs().iter().enumerate() {
                 if !known.contains(dof.as_str()) {
                     let path = match engine.cylinders {
                         crate::model::Cylinders::Count(_) => "engine.dof".to_string(),
                         crate::model::Cylinders::Dofs(_) => format!("engine.cylinders[{i}]"),
                     };
-                    let message = format!("unknown DOF `{dof}` (the scene has: {})", dofs.listing());
+                    let message =
+                        format!("unknown DOF `{dof}` (the scene has: {})", dofs.listing());
                     return Err(err(&path, message));
                 }
             }
-            let loads = engine
-                .validate("engine")
-                .and_then(|()| engine.loads(speed.order))
-                .map_err(|e| match &e {
-                    crate::Error::InvalidParameter { name, .. } => {
-                        err(&format!("engine.{name}"), e.to_string())
-                    }
-                    _ => err("engine", e.to_string()),
-                })?;
+            let loads = engine.loads(speed.order).map_err(engine_err)?;
             for (dof, k, c, s) in loads {
                 builder = builder.load(&dof, k, c, s);
             }
@@ -582,6 +585,7 @@ impl SceneFile {
             method,
             speed_unit: speed.unit,
             omega_per_speed: speed.per_unit * speed.order,
+            fundamental_order: speed.order,
             solver: self.solver,
         })
     }

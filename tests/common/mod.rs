@@ -3,6 +3,8 @@
 
 #![allow(dead_code)]
 
+pub mod time_domain;
+
 use num_complex::Complex64;
 
 /// A reference periodic solution: harmonics 0..=32 and its fundamental.
