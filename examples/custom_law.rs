@@ -4,13 +4,22 @@
 //! off. The example implements [`ForceLaw`], checks its derivatives, gives it a scene-file name,
 //! solves the periodic response by harmonic balance and checks it against the time domain.
 //!
-//! Run: `cargo run --release --example custom_law`
+//! Run: `cargo run --release --example custom_law`. The same file compiles as the `main.rs` of
+//! a crate of your own with only these dependencies (CI builds it that way):
+//!
+//! ```toml
+//! [dependencies]
+//! hbal = { path = "path/to/hbal" }   # or the version you use
+//! serde = { version = "1", features = ["derive"] }
+//! typetag = "0.2"
+//! ```
 
 use hbal::compare::relative_error;
 use hbal::force::{check_derivatives, ForceLaw, LinearPart};
 use hbal::timesim::TimeSimulation;
 use hbal::{FixedPoint, HarmonicBalance, HarmonicBasis, Model};
-use nalgebra::DMatrix;
+use hbal::nalgebra::DMatrix;
+use hbal::scene::Scene;
 
 /// One-sided Hertzian contact `f = k_h max(u - b, 0)^{3/2}`.
 #[derive(Debug, serde::Serialize, serde::Deserialize)]
@@ -66,19 +75,42 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         check.max_relative_error
     );
 
-    // The law has a scene-file name like the built-ins.
-    let boxed: Box<dyn ForceLaw> = Box::new(law);
-    let json = serde_json::to_string(&boxed)?;
-    println!("as a scene element: {json}");
-    let law: Box<dyn ForceLaw> = serde_json::from_str(&json)?;
+    // The law has a scene-file name like the built-ins: a scene names it by `type`.
+    let scene = Scene::from_str(
+        &format!(
+            r#"
+dofs = ["x"]
+mass = [[1.0]]
+damping = [[{c}]]
+fundamental = {{ rad_s = 0.6 }}
+harmonics = {{ count = 16 }}
+loads = [{{ dof = "x", order = 0, cos = {f0} }}, {{ dof = "x", order = 1, cos = {f1} }}]
 
+[[elements]]
+name = "hertz"
+type = "hertz_contact"
+connects = {{ x = 1.0 }}
+k_h = {k_h}
+b = {b}
+u_op = {u_op}
+"#,
+            u_op = law.u_op
+        ),
+        "hertz.toml",
+    )?;
+    println!("scene element: {:?}", scene.model.elements()[0].law());
+    // The same model in Rust.
     let model = Model::builder(&["x"])
         .mass_diagonal(&[1.0])
         .damping(DMatrix::from_element(1, 1, c))
-        .element_boxed("hertz", &[("x", 1.0)], law)
+        .element("hertz", &[("x", 1.0)], law)
         .load("x", 0, f0, 0.0)
         .load("x", 1, f1, 0.0)
         .build()?;
+    assert_eq!(
+        format!("{:?}", model.elements()[0].law()),
+        format!("{:?}", scene.model.elements()[0].law())
+    );
 
     let omega = 0.6;
     let hb = HarmonicBalance::new(&model, HarmonicBasis::new(omega, 16)?)?;
