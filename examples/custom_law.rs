@@ -16,10 +16,10 @@
 
 use hbal::compare::relative_error;
 use hbal::force::{check_derivatives, ForceLaw, LinearPart};
-use hbal::timesim::TimeSimulation;
-use hbal::{FixedPoint, HarmonicBalance, HarmonicBasis, Model};
 use hbal::nalgebra::DMatrix;
 use hbal::scene::Scene;
+use hbal::timesim::TimeSimulation;
+use hbal::{FixedPoint, HarmonicBalance, HarmonicBasis, Model};
 
 /// One-sided Hertzian contact `f = k_h max(u - b, 0)^{3/2}`.
 #[derive(Debug, serde::Serialize, serde::Deserialize)]

@@ -1,0 +1,123 @@
+//! The scene's `[solver]` table: the method and its options.
+
+use super::{Scene, SceneError};
+use crate::solve::{Anderson, Broyden, FixedPoint, Method, Newton};
+use serde::Deserialize;
+
+/// Names of the solver methods.
+pub const METHODS: [&str; 4] = ["fixed_point", "newton", "broyden", "anderson"];
+
+/// Solver settings; unset fields take the method's defaults.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SolverSpec {
+    method: Option<String>,
+    gamma: Option<f64>,
+    tolerance: Option<f64>,
+    max_iterations: Option<usize>,
+    depth: Option<usize>,
+}
+
+impl SolverSpec {
+    /// The method, optionally overriding the name.
+    pub(super) fn method(&self, name: Option<&str>) -> Result<Method, (String, String)> {
+        let name = name.or(self.method.as_deref()).unwrap_or("newton");
+        let e = |field: &str, x: crate::Error| (format!("solver.{field}"), x.to_string());
+        let method = match name {
+            "fixed_point" => {
+                let mut o = FixedPoint::new();
+                if let Some(g) = self.gamma {
+                    o = o.with_gamma(g).map_err(|x| e("gamma", x))?;
+                }
+                if let Some(t) = self.tolerance {
+                    o = o.with_tolerance(t).map_err(|x| e("tolerance", x))?;
+                }
+                if let Some(m) = self.max_iterations {
+                    o = o.with_max_iterations(m);
+                }
+                Method::FixedPoint(o)
+            }
+            "newton" => {
+                let mut o = Newton::new();
+                if let Some(t) = self.tolerance {
+                    o = o.with_tolerance(t).map_err(|x| e("tolerance", x))?;
+                }
+                if let Some(m) = self.max_iterations {
+                    o = o.with_max_iterations(m);
+                }
+                Method::Newton(o)
+            }
+            "broyden" => {
+                let mut o = Broyden::new();
+                if let Some(t) = self.tolerance {
+                    o = o.with_tolerance(t).map_err(|x| e("tolerance", x))?;
+                }
+                if let Some(m) = self.max_iterations {
+                    o = o.with_max_iterations(m);
+                }
+                Method::Broyden(o)
+            }
+            "anderson" => {
+                let mut o = Anderson::new();
+                if let Some(g) = self.gamma {
+                    o = o.with_gamma(g).map_err(|x| e("gamma", x))?;
+                }
+                if let Some(d) = self.depth {
+                    o = o.with_depth(d).map_err(|x| e("depth", x))?;
+                }
+                if let Some(t) = self.tolerance {
+                    o = o.with_tolerance(t).map_err(|x| e("tolerance", x))?;
+                }
+                if let Some(m) = self.max_iterations {
+                    o = o.with_max_iterations(m);
+                }
+                Method::Anderson(o)
+            }
+            other => {
+                return Err((
+                    "solver.method".into(),
+                    format!("unknown method `{other}` (one of: {})", METHODS.join(", ")),
+                ))
+            }
+        };
+        Ok(method)
+    }
+}
+
+impl Scene {
+    /// The scene's solver settings applied to another method (for `--method` and `compare`);
+    /// options meaningless for that method (γ for Newton) are ignored.
+    pub fn method_named(&self, name: &str) -> Result<Method, SceneError> {
+        let spec = SolverSpec {
+            method: None,
+            ..self.solver.clone()
+        };
+        let spec = match name {
+            "newton" | "broyden" => SolverSpec {
+                gamma: None,
+                depth: None,
+                ..spec
+            },
+            "fixed_point" => SolverSpec {
+                depth: None,
+                ..spec
+            },
+            _ => spec,
+        };
+        spec.method(Some(name))
+            .map_err(|(path, message)| SceneError {
+                file: self.file.clone(),
+                position: None,
+                path: Some(if name_is_known(name) {
+                    path
+                } else {
+                    "--method".into()
+                }),
+                message,
+            })
+    }
+}
+
+fn name_is_known(name: &str) -> bool {
+    METHODS.contains(&name)
+}
