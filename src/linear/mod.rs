@@ -4,6 +4,7 @@
 
 pub mod condensation;
 pub mod envelope;
+pub mod sparse_pattern;
 pub mod sparse_stiffness;
 
 pub use condensation::Condensation;

@@ -1,0 +1,160 @@
+//! The common sparsity pattern of `M`, `D0`, `K0` (compressed columns) with their values, from
+//! which `Z_k = -(kΩ)² M + i kΩ D0 + K0` is formed at any frequency without reassembly; and the
+//! sparse Cholesky test of a mass matrix.
+
+use crate::model::SparseMatrix;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use num_complex::Complex64;
+
+/// The pattern of `M`, `D0`, `K0` in compressed columns, with their values at each position.
+#[derive(Debug, Clone)]
+pub struct SparsePattern {
+    pub(super) n: usize,
+    pub(super) col_ptr: Vec<usize>,
+    pub(super) row_idx: Vec<usize>,
+    pub(super) m: Vec<f64>,
+    pub(super) d: Vec<f64>,
+    pub(super) k: Vec<f64>,
+}
+
+impl SparsePattern {
+    /// The union of the nonzeros of `M`, `D0`, `K0` (and the diagonal, so that a structurally
+    /// empty row is a clear singular error rather than a missing pivot).
+    pub fn new(m: &SparseMatrix, d: &SparseMatrix, k: &SparseMatrix) -> Self {
+        let n = m.n();
+        // Tag each entry with its matrix, merge by position.
+        let mut t: Vec<(usize, usize, u8, f64)> =
+            Vec::with_capacity(m.nnz() + d.nnz() + k.nnz() + n);
+        for (tag, a) in [(0u8, m), (1, d), (2, k)] {
+            t.extend(a.iter().map(|(i, j, v)| (i, j, tag, v)));
+        }
+        t.extend((0..n).map(|i| (i, i, 3, 0.0)));
+        t.sort_unstable_by_key(|&(i, j, _, _)| (j, i));
+        let mut col_ptr = vec![0; n + 1];
+        let (mut row_idx, mut mv, mut dv, mut kv) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut last = None;
+        for (i, j, tag, v) in t {
+            if last != Some((i, j)) {
+                last = Some((i, j));
+                row_idx.push(i);
+                mv.push(0.0);
+                dv.push(0.0);
+                kv.push(0.0);
+                col_ptr[j + 1] += 1;
+            }
+            let p = row_idx.len() - 1;
+            match tag {
+                0 => mv[p] += v,
+                1 => dv[p] += v,
+                2 => kv[p] += v,
+                _ => {}
+            }
+        }
+        for j in 0..n {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        Self {
+            n,
+            col_ptr,
+            row_idx,
+            m: mv,
+            d: dv,
+            k: kv,
+        }
+    }
+
+    /// `true` if `M`, `D0`, `K0` are symmetric to rounding (1e-13 of each one's largest
+    /// entry: an assembly sums `(i, j)` and `(j, i)` in different orders).
+    pub(super) fn is_symmetric(&self) -> bool {
+        let n = self.n;
+        let amax = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let tol = [amax(&self.m), amax(&self.d), amax(&self.k)].map(|a| 1e-13 * a);
+        (0..n).all(|j| {
+            (self.col_ptr[j]..self.col_ptr[j + 1]).all(|p| {
+                let i = self.row_idx[p];
+                let s = self.col_ptr[i]..self.col_ptr[i + 1];
+                match self.row_idx[s.clone()].binary_search(&j) {
+                    Ok(q) => {
+                        let q = s.start + q;
+                        (self.m[q] - self.m[p]).abs() <= tol[0]
+                            && (self.d[q] - self.d[p]).abs() <= tol[1]
+                            && (self.k[q] - self.k[p]).abs() <= tol[2]
+                    }
+                    Err(_) => false,
+                }
+            })
+        })
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Order n.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The values of `Z(w) + s M = -(w² - s) M + i w D0 + K0` on the pattern.
+    pub(super) fn values(&self, w: f64, s: f64) -> Vec<Complex64> {
+        (0..self.nnz())
+            .map(|p| Complex64::new(self.k[p] - (w * w - s) * self.m[p], w * self.d[p]))
+            .collect()
+    }
+
+    /// `out ← (Z(w) + s M) x`.
+    pub(super) fn apply(&self, w: f64, s: f64, x: &[Complex64], out: &mut [Complex64]) {
+        out.fill(Complex64::default());
+        for (j, xj) in x.iter().enumerate() {
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let z = Complex64::new(self.k[p] - (w * w - s) * self.m[p], w * self.d[p]);
+                out[self.row_idx[p]] += z * xj;
+            }
+        }
+    }
+
+    /// `out ← (dZ/dΩ) x` for `Z = -(κΩ)² M + i κΩ D0 + K0`: `(-2κ²Ω M + i κ D0) x`.
+    pub(super) fn apply_omega_derivative(
+        &self,
+        kappa: f64,
+        omega: f64,
+        x: &[Complex64],
+        out: &mut [Complex64],
+    ) {
+        out.fill(Complex64::default());
+        for (j, xj) in x.iter().enumerate() {
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let dz =
+                    Complex64::new(-2.0 * kappa * kappa * omega * self.m[p], kappa * self.d[p]);
+                out[self.row_idx[p]] += dz * xj;
+            }
+        }
+    }
+
+    pub(super) fn symbolic(&self) -> SymbolicSparseColMat<usize> {
+        SymbolicSparseColMat::new_checked(
+            self.n,
+            self.n,
+            self.col_ptr.clone(),
+            None,
+            self.row_idx.clone(),
+        )
+    }
+}
+
+/// `true` if the symmetric `a` is positive definite (sparse Cholesky of its lower triangle
+/// succeeds).
+pub fn is_positive_definite(a: &SparseMatrix) -> bool {
+    use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+    use faer::Side;
+    let (col_ptr, row_idx, values) = a.parts();
+    let structure =
+        SymbolicSparseColMat::new_checked(a.n(), a.n(), col_ptr.to_vec(), None, row_idx.to_vec());
+    let Ok(symbolic) = SymbolicLlt::try_new(structure.as_ref(), Side::Lower) else {
+        return false;
+    };
+    let mat = SparseColMat::new(structure, values.to_vec());
+    Llt::try_new_with_symbolic(symbolic, mat.as_ref(), Side::Lower).is_ok()
+}
