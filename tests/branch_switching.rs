@@ -30,9 +30,18 @@ fn chain_switches_to_both_asymmetric_orbits() {
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/chain_backlash.toml"),
     )
     .unwrap();
+    // Both formulations: all DOFs, and the element coordinate of the one contact (condensed).
+    for formulation in [hbal::Formulation::Full, hbal::Formulation::Condensed] {
+        eprintln!("{formulation:?}");
+        chain_switch(&scene, formulation);
+    }
+}
+
+fn chain_switch(scene: &hbal::scene::Scene, formulation: hbal::Formulation) {
     let basis = HarmonicBasis::new(1.3, 64).unwrap();
     let cont = Continuation {
-        method: scene.method,
+        method: scene.method.clone(),
+        formulation,
         ..Continuation::default()
     };
     let main = cont.run(&scene.model, basis, 1.36, |_| {}).unwrap();
@@ -130,9 +139,22 @@ fn gear_pair_switches_to_the_period_two_orbit() {
     )
     .unwrap();
     let r: serde_json::Value = serde_json::from_str(&text).unwrap();
+    // Both formulations (one DOF and one element: as many coordinates as DOFs).
+    for formulation in [hbal::Formulation::Full, hbal::Formulation::Condensed] {
+        eprintln!("{formulation:?}");
+        gear_pair_switch(&scene, &r, formulation);
+    }
+}
+
+fn gear_pair_switch(
+    scene: &hbal::scene::Scene,
+    r: &serde_json::Value,
+    formulation: hbal::Formulation,
+) {
     let basis = HarmonicBasis::new(2.3, 32).unwrap();
     let cont = Continuation {
-        method: scene.method,
+        method: scene.method.clone(),
+        formulation,
         ..Continuation::default()
     };
     let main = cont.run(&scene.model, basis, 2.1, |_| {}).unwrap();

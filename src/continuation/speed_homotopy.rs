@@ -20,7 +20,7 @@ pub fn solve_robustly(
     basis: HarmonicBasis,
     continuation: &Continuation,
 ) -> Result<StartReport> {
-    let mut hb = HarmonicBalance::new(model, basis)?;
+    let mut hb = HarmonicBalance::with_formulation(model, basis, continuation.formulation)?;
     let mut ws = hb.workspace();
     let direct = robust_start(
         &mut hb,

@@ -121,18 +121,24 @@ impl Continuation {
             ));
         };
         // 2. The parent branch and its second null direction on `basis`.
-        let hb = HarmonicBalance::new(model, basis.with_omega(o_star)?)?;
+        let hb =
+            HarmonicBalance::with_formulation(model, basis.with_omega(o_star)?, self.formulation)?;
         let layout = hb.layout();
         let m = layout.len();
+        // Full harmonics on the parent's basis, embedded in `basis`, as unknowns (all DOFs, or
+        // the element coordinates when condensed).
         let pack = |q: &[Complex64]| {
+            let embedded = crate::harmonic::embed(q, model.n_dofs(), ratio, basis.harmonics());
+            let unknowns = hb.unknowns_of(&embedded)?;
             let mut x = vec![0.0; m];
-            layout.pack(
-                &crate::harmonic::embed(q, model.n_dofs(), ratio, basis.harmonics()),
-                &mut x,
-            );
-            x
+            layout.pack(&unknowns, &mut x);
+            Some(x)
         };
-        let (xa, xb, x_star) = (pack(&pa.harmonics), pack(&pb.harmonics), pack(&q_star));
+        let (Some(xa), Some(xb), Some(x_star)) =
+            (pack(&pa.harmonics), pack(&pb.harmonics), pack(&q_star))
+        else {
+            return Ok(failed(o_star, "the branch points do not match the basis"));
+        };
         let max_abs: Vec<f64> = Solution::from_harmonics(
             parent_basis.with_omega(o_star)?,
             model.dof_names().to_vec(),
@@ -267,12 +273,16 @@ impl Continuation {
         if fa * fb > 0.0 {
             return Ok(None);
         }
-        let hb = HarmonicBalance::new(model, basis)?;
+        let hb = HarmonicBalance::with_formulation(model, basis, self.formulation)?;
         let layout = hb.layout();
         let m = layout.len();
         let (mut xa, mut xb) = (vec![0.0; m], vec![0.0; m]);
-        layout.pack(&a.harmonics, &mut xa);
-        layout.pack(&b.harmonics, &mut xb);
+        let (Some(ua), Some(ub)) = (hb.unknowns_of(&a.harmonics), hb.unknowns_of(&b.harmonics))
+        else {
+            return Ok(None);
+        };
+        layout.pack(&ua, &mut xa);
+        layout.pack(&ub, &mut xb);
         let mut tr = Tracer::new(hb, Scales::new(0.0, a.omega, 1.0));
         tr.sc = Scales::new(tr.rms(&xa), a.omega, tr.load_norm());
         let (chord, h) = tr.chord(&xa, a.omega, &xb, b.omega);
@@ -302,8 +312,12 @@ impl Continuation {
             let Some((_, rel)) = self.correct(&mut tr, &mut xc, &mut oc, &target) else {
                 return Ok(None);
             };
-            let mut q = vec![Complex64::default(); tr.hb.len()];
-            layout.unpack(&xc, &mut q);
+            let mut unknowns = vec![Complex64::default(); tr.hb.len()];
+            layout.unpack(&xc, &mut unknowns);
+            // All DOFs (`tr.hb` sits at `oc` after the corrector).
+            let Ok(q) = tr.hb.full_harmonics(&unknowns, &mut tr.hb.workspace().eval) else {
+                return Ok(None);
+            };
             let sol = Solution::from_harmonics(
                 basis.with_omega(oc)?,
                 model.dof_names().to_vec(),

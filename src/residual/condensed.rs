@@ -88,12 +88,11 @@ impl HarmonicBalance<'_> {
     /// The unknowns of full harmonics `q` (`(H+1) n`): `q` itself, or `U = Wᵀ Q` when
     /// condensed; `None` if `q` has neither length.
     pub fn unknowns_of(&self, q: &[Complex64]) -> Option<Vec<Complex64>> {
-        if q.len() == self.len() {
-            return Some(q.to_vec());
-        }
         let n = self.model.n_dofs();
         match &self.condensed {
+            // Full harmonics first: with as many elements as DOFs both have one length.
             Some(b) if q.len() == (self.basis.harmonics() + 1) * n => Some(b.0.project(q)),
+            _ if q.len() == self.len() => Some(q.to_vec()),
             _ => None,
         }
     }
