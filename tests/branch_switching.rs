@@ -40,7 +40,7 @@ fn chain_switches_to_both_asymmetric_orbits() {
 fn chain_switch(scene: &hbal::scene::Scene, formulation: hbal::Formulation) {
     let basis = HarmonicBasis::new(1.3, 64).unwrap();
     let cont = Continuation {
-        method: scene.method.clone(),
+        method: scene.method,
         formulation,
         ..Continuation::default()
     };
@@ -153,7 +153,7 @@ fn gear_pair_switch(
 ) {
     let basis = HarmonicBasis::new(2.3, 32).unwrap();
     let cont = Continuation {
-        method: scene.method.clone(),
+        method: scene.method,
         formulation,
         ..Continuation::default()
     };
