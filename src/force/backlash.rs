@@ -159,6 +159,13 @@ impl ForceLaw for Backlash {
             offset,
         }
     }
+    fn state_names(&self) -> &'static [&'static str] {
+        if self.half_backlash > 0.0 {
+            &["coast", "open", "drive"]
+        } else {
+            &["coast", "drive"]
+        }
+    }
     fn kinks(&self) -> Vec<f64> {
         let b = self.half_backlash;
         if b > 0.0 {

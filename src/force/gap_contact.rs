@@ -195,6 +195,9 @@ impl ForceLaw for GapContact {
     fn kinks(&self) -> Vec<f64> {
         vec![self.gap]
     }
+    fn state_names(&self) -> &'static [&'static str] {
+        &["open", "contact"]
+    }
     fn time_breakpoints(&self) -> Vec<f64> {
         jump_angles(&self.stiffness.jumps(), self.teeth, self.phase)
     }

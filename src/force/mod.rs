@@ -192,6 +192,13 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
         Vec::new()
     }
 
+    /// Names of the states between the law's [`kinks`](ForceLaw::kinks), from the lowest `u`
+    /// up (a backlash contact: `coast`, `open`, `drive`), for reports of the fraction of the
+    /// period spent in each. Default: none (reports number the intervals instead).
+    fn state_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+
     /// `true` if the force is exactly `k0 u + d0 u̇` at all times: the element then lives
     /// entirely in `K0`, `D0` and costs nothing in the time domain. Default: `false`.
     fn is_linear_time_invariant(&self) -> bool {

@@ -117,6 +117,9 @@ impl ForceLaw for Offset {
     fn kinks(&self) -> Vec<f64> {
         self.law.kinks().iter().map(|k| k + self.offset).collect()
     }
+    fn state_names(&self) -> &'static [&'static str] {
+        self.law.state_names()
+    }
     fn is_linear_time_invariant(&self) -> bool {
         // Exact: f = k0 (u - u0) + d0 u̇ + f0 = k0 u + d0 u̇ + (f0 - k0 u0), and the residual
         // carries every element's static offset as a load (also for LTI elements).

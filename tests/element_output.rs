@@ -1,0 +1,123 @@
+//! Element outputs against hand computations from the DOF harmonics: a gear stage's
+//! transmission error and mesh force (static balance of the pinion), and a backlash contact's
+//! contact-state fractions with contact loss.
+
+use hbal::report::element_outputs;
+use hbal::scene::Scene;
+use hbal::{HarmonicBalance, HarmonicBasis, Newton, Solution};
+use std::path::Path;
+
+fn solve(scene: &Scene, omega: f64) -> Solution {
+    let basis = HarmonicBasis::new(omega, scene.basis.harmonics()).unwrap();
+    let hb = HarmonicBalance::new(&scene.model, basis).unwrap();
+    let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
+    assert!(sol.is_converged(), "{}", sol.termination);
+    sol
+}
+
+fn scene(name: &str) -> Scene {
+    Scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/scenes")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// The two-inertia gear pair: `u = r1 θ1 - r2 θ2` from the DOF harmonics; the mean mesh force
+/// from the pinion's static balance `T - k_p θ̄1 - r1 f̄ = 0` (drive torque 20 N m, shaft
+/// 1e4 N m/rad); the dynamic factor `f_max / f̄`.
+#[test]
+fn gear_stage_transmission_error_and_mesh_force_by_hand() {
+    let s = scene("two_shaft_gear_pair.toml");
+    let sol = solve(&s, s.basis.omega());
+    let out = element_outputs(&s.model, &sol).unwrap();
+    let mesh = &out[0];
+    assert_eq!(mesh.kind, "gear_stage");
+    let (r1, r2) = (0.02, 0.04);
+    let h = sol.basis().harmonics();
+    for k in 0..=h {
+        let by_hand = sol.harmonic(0, k) * r1 - sol.harmonic(1, k) * r2;
+        assert!(
+            (mesh.coordinate.harmonics[k] - by_hand).norm() < 1e-15,
+            "k {k}"
+        );
+    }
+    let m = mesh.mesh.unwrap();
+    assert_eq!(m.te_unit, "µm");
+    let te_mean = 1e6 * (r1 * sol.harmonic(0, 0).re - r2 * sol.harmonic(1, 0).re);
+    assert!(
+        (m.te_mean - te_mean).abs() < 1e-9 * te_mean.abs(),
+        "{} vs {te_mean}",
+        m.te_mean
+    );
+    // The static balance of the pinion gives the mean mesh force.
+    let f_static = (20.0 - 1e4 * sol.harmonic(0, 0).re) / r1;
+    assert!(
+        (m.force_mean - f_static).abs() < 1e-6 * f_static,
+        "{} vs {f_static}",
+        m.force_mean
+    );
+    // ... and the gear's: r2 f̄ = k_g θ̄2 - T_load with T_load = -40 N m.
+    let f_gear = (4e4 * sol.harmonic(1, 0).re + 40.0) / r2;
+    assert!(
+        (m.force_mean - f_gear).abs() < 1e-6 * f_gear,
+        "{} vs {f_gear}",
+        m.force_mean
+    );
+    assert!((m.dynamic_factor - m.force_max / m.force_mean).abs() < 1e-15);
+    assert!(m.dynamic_factor > 1.0 && m.dynamic_force > 0.0);
+    // The TE peak-to-peak from a fine time series of the harmonics.
+    let fine: Vec<f64> = (0..20000)
+        .map(|j| {
+            let t = std::f64::consts::TAU * j as f64 / 20000.0;
+            r1 * sol.displacement(0, t) - r2 * sol.displacement(1, t)
+        })
+        .collect();
+    let p2p = fine.iter().cloned().fold(f64::MIN, f64::max)
+        - fine.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(
+        (m.te_peak_to_peak - 1e6 * p2p).abs() < 1e-3 * 1e6 * p2p,
+        "{} vs {}",
+        m.te_peak_to_peak,
+        1e6 * p2p
+    );
+}
+
+/// The backlash gear pair at W = 1.0 loses contact: the fractions of the period on the coast
+/// flank, open and on the drive flank sum to one and match a count on the orbit.
+#[test]
+fn backlash_contact_states_with_contact_loss() {
+    let s = scene("gear_backlash.toml");
+    let sol = solve(&s, 1.0);
+    let out = element_outputs(&s.model, &sol).unwrap();
+    let c = &out[0];
+    assert_eq!(c.kind, "backlash");
+    let names: Vec<&str> = c.states.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["coast", "open", "drive"]);
+    let total: f64 = c.states.iter().map(|(_, f)| f).sum();
+    assert!((total - 1.0).abs() < 1e-12);
+    let samples = 100_000;
+    let mut count = [0usize; 3];
+    for j in 0..samples {
+        let x = sol.displacement(0, std::f64::consts::TAU * j as f64 / samples as f64);
+        count[if x < -1.0 {
+            0
+        } else if x <= 1.0 {
+            1
+        } else {
+            2
+        }] += 1;
+    }
+    for (i, (name, f)) in c.states.iter().enumerate() {
+        let by_count = count[i] as f64 / samples as f64;
+        assert!((f - by_count).abs() < 1e-3, "{name}: {f} vs {by_count}");
+    }
+    assert!(
+        c.states[1].1 > 0.05,
+        "contact loss expected: {:?}",
+        c.states
+    );
+    // No force while open: the force's minimum over the period is 0 or below (coast impacts).
+    assert!(c.force.min <= 1e-12);
+}
