@@ -112,7 +112,14 @@ pub(crate) fn add_element_jacobian(
                     scratch.column[2 * k] = -2.0 * d.im;
                 }
             }
-            add_local_column(&scratch.column, RealLayout::block(l, part), weights, n, data, rows);
+            add_local_column(
+                &scratch.column,
+                RealLayout::block(l, part),
+                weights,
+                n,
+                data,
+                rows,
+            );
         }
     }
 }

@@ -78,10 +78,7 @@ pub fn march(
     let (n, s) = (theta.len(), law.state_len().min(MAX_STATE));
     let mut state = [0.0; MAX_STATE];
     law.initial_state(&mut state[..s]);
-    let scale = u
-        .iter()
-        .map(|x| x.abs())
-        .fold(f64::MIN_POSITIVE, f64::max);
+    let scale = u.iter().map(|x| x.abs()).fold(f64::MIN_POSITIVE, f64::max);
     if columns > 0 {
         b.sens[..s * columns].fill(0.0);
     }

@@ -185,9 +185,7 @@ impl EngineExcitation {
             if sorted != (1..=n).collect::<Vec<_>>() {
                 return Err(bad(
                     "firing_order",
-                    format!(
-                        "must list each of the {n} cylinders 1..={n} once, got {order:?}"
-                    ),
+                    format!("must list each of the {n} cylinders 1..={n} once, got {order:?}"),
                 ));
             }
         }

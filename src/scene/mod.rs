@@ -344,7 +344,8 @@ impl SceneFile {
                         crate::model::Cylinders::Count(_) => "engine.dof".to_string(),
                         crate::model::Cylinders::Dofs(_) => format!("engine.cylinders[{i}]"),
                     };
-                    let message = format!("unknown DOF `{dof}` (the scene has: {})", dofs.listing());
+                    let message =
+                        format!("unknown DOF `{dof}` (the scene has: {})", dofs.listing());
                     return Err(err(&path, message));
                 }
             }
