@@ -37,6 +37,8 @@ struct Commit<'a, 'm> {
     out: &'a mut [Option<Vec<f64>>],
     next: usize,
     error: &'a mut Option<String>,
+    /// Where the integration stopped to restart, and the state there.
+    restart: &'a mut Option<(f64, Vec<f64>)>,
 }
 
 impl Commit<'_, '_> {
@@ -65,6 +67,30 @@ impl Commit<'_, '_> {
             }
         }
         agree
+    }
+
+    /// `true` if a state moved from `before` to `end` over the last sub-interval (ending at
+    /// `t`, state `y`) but does not move a little further along the velocity: it stopped
+    /// inside that sub-interval (a slider's turn the sub-points stepped over).
+    fn stops_after(&self, t: f64, y: &[f64], before: &States, end: &States) -> bool {
+        let model = self.rhs.model();
+        let n = model.n_dofs();
+        let (q, v) = y.split_at(n);
+        let theta = self.rhs.theta(t);
+        let eps = 1e-9 * t.abs().max(1.0);
+        let ahead: Vec<f64> = q.iter().zip(v).map(|(x, w)| x + eps * w).collect();
+        model.elements().iter().enumerate().any(|(i, e)| {
+            let Some(m) = e.law().memory() else {
+                return false;
+            };
+            let len = m.state_len();
+            if before[i][..len] == end[i][..len] {
+                return false;
+            }
+            let mut p = end[i];
+            m.step(theta, e.gather(&ahead), e.gather(v), &mut p[..len]);
+            p[..len] == end[i][..len]
+        })
     }
 
     /// Records the sample times up to `t` (`y_at` gives the state there).
@@ -106,7 +132,9 @@ impl Solout<f64, Vec<f64>> for Commit<'_, '_> {
         let mut path: States = self.rhs.states.borrow().clone();
         let mut cut = None;
         for _ in 0..LEVELS {
-            let mut differs = false;
+            // The path at a, τ_1, ..., up to the first sub-point where the frozen force differs.
+            let mut hist = vec![path.clone()];
+            let mut differs = None;
             for k in 1..=SUBSTEPS {
                 let t = if k == SUBSTEPS {
                     b
@@ -117,20 +145,59 @@ impl Solout<f64, Vec<f64>> for Commit<'_, '_> {
                     *self.error = Some(format!("no dense output at t = {t}"));
                     return ControlFlag::Terminate;
                 };
-                let before = path.clone();
-                if !self.advance(t, &y, &mut path) {
-                    path = before;
-                    (b, differs) = (t, true);
+                let mut p = hist[k - 1].clone();
+                if !self.advance(t, &y, &mut p) {
+                    differs = Some(k);
                     break;
                 }
-                a = t;
+                hist.push(p);
             }
-            if !differs {
-                break;
+            let tau = |k: usize| a + (b - a) * k as f64 / SUBSTEPS as f64;
+            match differs {
+                // The state stopped (a slider's turn) between τ_{k-2} and τ_k, where the path
+                // may have stepped over the extremum: refine both sub-intervals.
+                Some(k) => {
+                    cut = Some((tau(k - 1), hist[k - 1].clone()));
+                    let k0 = k.saturating_sub(2);
+                    (a, b) = (tau(k0), tau(k));
+                    path = hist[k0].clone();
+                }
+                None => {
+                    let last = hist.len() - 1;
+                    // Still moving at the end but stopping right after it: the extremum lies in
+                    // the last sub-interval; refine it (the next step can no longer).
+                    let y = at(b).unwrap_or_else(|| y_curr.clone());
+                    if self.stops_after(b, &y, &hist[last - 1], &hist[last]) {
+                        cut = None;
+                        (a, path) = (tau(last - 1), hist[last - 1].clone());
+                        continue;
+                    }
+                    path = hist.pop().unwrap_or(path);
+                    if cut.is_some() {
+                        cut = Some((b, path.clone()));
+                    }
+                    break;
+                }
             }
-            cut = Some(a);
         }
-        match cut {
+        let restart = match cut {
+            Some((tc, p)) if tc < t_curr => Some(if tc > t_prev {
+                (tc, p)
+            } else {
+                // The state stopped right at the step's start: restart just after it.
+                let mut p = p;
+                if let Some(y) = at(b) {
+                    self.advance(b, &y, &mut p);
+                }
+                (b, p)
+            }),
+            Some((_, p)) => {
+                path = p;
+                None
+            }
+            None => None,
+        };
+        match restart {
             // The frozen state held over the whole step.
             None => {
                 *self.rhs.states.borrow_mut() = path;
@@ -140,17 +207,16 @@ impl Solout<f64, Vec<f64>> for Commit<'_, '_> {
                 }
                 ControlFlag::Continue
             }
-            // Restart where it stopped holding (past the step's start: a frozen state agrees
-            // with its own path there, so the subdivision always moves on).
-            Some(tc) => {
-                let tc = if tc > t_prev { tc } else { b };
+            // Restart where it stopped holding.
+            Some((tc, p)) => {
                 let Some(yc) = at(tc) else {
                     *self.error = Some(format!("no dense output at t = {tc}"));
                     return ControlFlag::Terminate;
                 };
-                *self.rhs.states.borrow_mut() = path;
+                *self.rhs.states.borrow_mut() = p;
                 self.record(tc, &mut at);
-                ControlFlag::ModifyState(tc, yc)
+                *self.restart = Some((tc, yc));
+                ControlFlag::Terminate
             }
         }
     }
@@ -183,33 +249,50 @@ pub(super) fn integrate_segment(
         .collect();
     let mut out = vec![None; times.len()];
     let mut error = None;
-    let commit = Commit {
-        rhs,
-        t_end: tb,
-        times: &times,
-        out: &mut out,
-        next: 0,
-        error: &mut error,
-    };
-    let mut method = ExplicitRungeKutta::dop853()
-        .rtol(rtol)
-        .atol(atol.to_vec())
-        .max_steps(usize::MAX / 4);
-    if let Some(h) = h_max {
-        method = method.h_max(h);
+    let (mut t, mut y, mut next) = (ta, y, 0);
+    // A fresh integrator from every restart (its first step chosen for what is left).
+    loop {
+        let mut restart = None;
+        let commit = Commit {
+            rhs,
+            t_end: tb,
+            times: &times,
+            out: &mut out,
+            next,
+            error: &mut error,
+            restart: &mut restart,
+        };
+        let mut method = ExplicitRungeKutta::dop853()
+            .rtol(rtol)
+            .atol(atol.to_vec())
+            .max_steps(usize::MAX / 4);
+        if let Some(h) = h_max {
+            method = method.h_max(h);
+        }
+        let sol = IVP::ode(rhs, t, tb, y.clone())
+            .method(method)
+            .solout(commit)
+            .solve()
+            .map_err(|e| Error::TimeIntegration {
+                reason: format!("{e:?}"),
+            })?;
+        if let Some(reason) = error {
+            return Err(Error::TimeIntegration { reason });
+        }
+        *steps += sol.steps.accepted + sol.steps.rejected;
+        *evals += sol.evals.function;
+        next = out.iter().take_while(|o| o.is_some()).count();
+        match restart {
+            Some((tc, yc)) => (t, y) = (tc, yc),
+            None => {
+                let (t_end, y_end) = sol.last().map_err(|e| Error::TimeIntegration {
+                    reason: e.to_string(),
+                })?;
+                (t, y) = (*t_end, y_end.clone());
+                break;
+            }
+        }
     }
-    let sol = IVP::ode(rhs, ta, tb, y)
-        .method(method)
-        .solout(commit)
-        .solve()
-        .map_err(|e| Error::TimeIntegration {
-            reason: format!("{e:?}"),
-        })?;
-    if let Some(reason) = error {
-        return Err(Error::TimeIntegration { reason });
-    }
-    *steps += sol.steps.accepted + sol.steps.rejected;
-    *evals += sol.evals.function;
     if let Some(rows) = samples {
         for (&j, yj) in js.iter().zip(&out) {
             let Some(yj) = yj else {
@@ -222,8 +305,5 @@ pub(super) fn integrate_segment(
             }
         }
     }
-    let (t, y) = sol.last().map_err(|e| Error::TimeIntegration {
-        reason: e.to_string(),
-    })?;
-    Ok((*t, y.clone()))
+    Ok((t, y))
 }
