@@ -60,7 +60,8 @@ impl Commit<'_, '_> {
             };
             let len = m.state_len();
             let (u, du) = (e.gather(q), e.gather(v));
-            let f_frozen = m.step(theta, u, du, &mut fz.clone()[..len]);
+            let mut frozen_state = *fz;
+            let f_frozen = m.step(theta, u, du, &mut frozen_state[..len]);
             let f_path = m.step(theta, u, du, &mut p[..len]);
             if (f_frozen - f_path).abs() > AGREE * f_frozen.abs().max(f_path.abs()) {
                 agree = false;

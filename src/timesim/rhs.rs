@@ -95,7 +95,10 @@ impl ODE<f64, Vec<f64>> for Rhs<'_> {
             let (u, du) = (e.gather(q), e.gather(v));
             let f = match e.law().memory() {
                 None => e.law().force(theta, u, du),
-                Some(m) => m.step(theta, u, du, &mut s.clone()[..m.state_len()]),
+                Some(m) => {
+                    let mut frozen = *s;
+                    m.step(theta, u, du, &mut frozen[..m.state_len()])
+                }
             };
             e.scatter_add(-f, a.as_mut_slice());
         }
