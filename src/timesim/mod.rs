@@ -13,7 +13,7 @@
 //! exactly piecewise. State-dependent kinks (backlash contact) are left to the error control;
 //! tighten `rtol` (or limit the step with `max_step`) to check them. Laws with memory
 //! (a Jenkins slider) keep their state frozen over a step and commit it after the step, with a
-//! restart where the frozen state stops being the true one (see [`memory`]).
+//! restart where the frozen state stops being the true one (the module `timesim::memory` in the source).
 
 mod memory;
 mod rhs;
