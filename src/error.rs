@@ -128,6 +128,14 @@ pub enum Error {
         /// argmin's message.
         reason: String,
     },
+    /// An analysis that does not support laws with memory (hysteresis).
+    #[error("{analysis} not available for laws with memory (element `{element}`)")]
+    MemoryUnsupported {
+        /// The analysis, e.g. `stability`.
+        analysis: String,
+        /// The element whose law has memory.
+        element: String,
+    },
     /// The time-domain reference integration failed.
     #[error("time integration failed: {reason}")]
     TimeIntegration {

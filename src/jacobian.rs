@@ -112,20 +112,41 @@ pub(crate) fn add_element_jacobian(
                     scratch.column[2 * k] = -2.0 * d.im;
                 }
             }
-            let cb = RealLayout::block(l, part);
-            for &(j, wj) in weights {
-                let col = &mut data[(cb * n + j) * rows..(cb * n + j + 1) * rows];
-                for &(i, wi) in weights {
-                    let w = wi * wj;
-                    if n == 1 {
-                        for (x, c) in col.iter_mut().zip(&scratch.column) {
-                            *x += w * c;
-                        }
-                    } else {
-                        for (r, c) in scratch.column.iter().enumerate() {
-                            col[r * n + i] += w * c;
-                        }
-                    }
+            add_local_column(
+                &scratch.column,
+                RealLayout::block(l, part),
+                weights,
+                n,
+                data,
+                rows,
+            );
+        }
+    }
+}
+
+/// `jac += (w wᵀ) ⊗ column` in the columns of block `cb`: the local column (rows in the real
+/// layout of one coordinate, `2H+1`) of the element's unknown `cb` spread over its DOFs.
+/// `data` is the column-major storage of the Jacobian with `rows` rows.
+#[inline]
+pub(crate) fn add_local_column(
+    column: &[f64],
+    cb: usize,
+    weights: &[(usize, f64)],
+    n: usize,
+    data: &mut [f64],
+    rows: usize,
+) {
+    for &(j, wj) in weights {
+        let col = &mut data[(cb * n + j) * rows..(cb * n + j + 1) * rows];
+        for &(i, wi) in weights {
+            let w = wi * wj;
+            if n == 1 {
+                for (x, c) in col.iter_mut().zip(column) {
+                    *x += w * c;
+                }
+            } else {
+                for (r, c) in column.iter().enumerate() {
+                    col[r * n + i] += w * c;
                 }
             }
         }

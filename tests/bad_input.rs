@@ -153,7 +153,7 @@ fn model_errors_name_the_place() {
 #[test]
 fn new_law_errors_name_element_and_field() {
     use hbal::force::{
-        ForceLaw, Friction, GapContact, Offset, PolynomialSpring, QuadraticDamper, Stage,
+        ForceLaw, Friction, GapContact, Jenkins, Offset, PolynomialSpring, QuadraticDamper, Stage,
         StopSpring,
     };
     let build = |law: Box<dyn ForceLaw>| {
@@ -218,6 +218,22 @@ fn new_law_errors_name_element_and_field() {
         (
             Box::new(Friction::new(0.5, 0.0)),
             "element `el`: parameter `regularization` must be finite and > 0, got 0",
+        ),
+        (
+            Box::new(Jenkins::new(-20.0, 1.0)),
+            "element `el`: parameter `stiffness` must be finite and >= 0, got -20",
+        ),
+        (
+            Box::new(Jenkins::new(20.0, -1.0)),
+            "element `el`: parameter `limit` must be finite and >= 0, got -1",
+        ),
+        (
+            Box::new(Offset::new(0.1, Jenkins::new(20.0, f64::INFINITY))),
+            "element `el`: parameter `limit` must be finite and >= 0, got inf",
+        ),
+        (
+            Box::new(Jenkins::new(20.0, 1.0).with_damping(f64::NAN)),
+            "element `el`: parameter `damping` must be finite and >= 0, got NaN",
         ),
         (
             Box::new(QuadraticDamper::new(-2.0)),

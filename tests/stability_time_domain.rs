@@ -45,6 +45,15 @@ fn stability_labels_agree_with_time_integration_for_every_scene() {
             let label = format!("{} at {factor} x speed ({})", file.display(), start.how);
             let sol = start.solution;
             assert!(sol.is_converged(), "{label}");
+            // Laws with memory: no multipliers (never wrong ones), a clear refusal instead.
+            if let Some(e) = model.memory_element() {
+                let err = sol.stability(model).unwrap_err().to_string();
+                assert!(
+                    err.contains("not available for laws with memory") && err.contains(e.name()),
+                    "{label}: {err}"
+                );
+                continue;
+            }
             let floquet = sol.stability(model).unwrap();
             let kick = 1e-3;
             let x0 = &floquet.orbit_start;

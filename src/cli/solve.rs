@@ -89,8 +89,15 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     };
     // Stability of a converged orbit (an unconverged iterate is no orbit to judge).
     let started = Instant::now();
+    // Laws with memory: no multipliers rather than wrong ones (not a failure of the solve).
+    let unavailable = scene.model.memory_element().map(|e| {
+        format!(
+            "stability not available for laws with memory (element `{}`)",
+            e.name()
+        )
+    });
     let stability: Option<Result<Floquet, String>> =
-        (opts.stability && sol.is_converged()).then(|| {
+        (opts.stability && sol.is_converged() && unavailable.is_none()).then(|| {
             sol.stability(&scene.model)
                 .map_err(|e| e.to_string())
                 .and_then(|f| super::check_finite(&f).map(|_| f))
@@ -113,9 +120,10 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         })
         .collect();
     if as_json {
-        let stability_json = match &stability {
-            None => serde_json::Value::Null,
-            Some(Ok(f)) => json!({
+        let stability_json = match (&stability, &unavailable) {
+            (None, Some(u)) if opts.stability => json!({ "unavailable": u }),
+            (None, _) => serde_json::Value::Null,
+            (Some(Ok(f)), _) => json!({
                 "stable": f.is_stable(),
                 "max_abs": f.max_abs(),
                 "multipliers": multipliers_json(f),
@@ -126,7 +134,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 "seconds": stability_seconds,
                 "reduction": f.reduction,
             }),
-            Some(Err(e)) => json!({ "error": e }),
+            (Some(Err(e)), _) => json!({ "error": e }),
         };
         let doc = json!({
             "converged": sol.is_converged(),
@@ -198,6 +206,9 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             say!("  max |q| {name}: {:.6e}", max_abs[i]);
         }
         match &stability {
+            None if opts.stability && unavailable.is_some() => {
+                say!("  {}", unavailable.as_deref().unwrap_or_default())
+            }
             None if opts.stability => {
                 say!("  stability: not computed (the solve did not converge)")
             }

@@ -117,6 +117,13 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     if !(max_step.is_finite() && max_step > 0.0) {
         return Err(anyhow::anyhow!("--max-step must be finite and > 0, got {max_step}").into());
     }
+    if let Some(e) = scene.model.memory_element().filter(|_| opts.all_branches) {
+        return Err(anyhow::anyhow!(
+            "--all-branches needs the stability of the points, which is not available for laws with memory (element `{}`)",
+            e.name()
+        )
+        .into());
+    }
     if opts.all_branches && !opts.stability {
         return Err(anyhow::anyhow!(
             "--all-branches needs the stability of the points (drop --no-stability): branch points and period doublings are found from the Floquet multipliers"
@@ -270,6 +277,12 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 String::new()
             }
         );
+        if let Some(e) = scene.model.memory_element().filter(|_| opts.stability) {
+            say!(
+                "  stability unknown: not available for laws with memory (element `{}`)",
+                e.name()
+            );
+        }
         let worst = branch
             .points
             .iter()

@@ -50,6 +50,8 @@ impl Continuation {
             Err(e) => return Some(e.to_string()),
         };
         let (floquet, failure) = match &self.stability {
+            // Laws with memory: stability unknown (see FloquetOptions::compute), the branch goes on.
+            Some(_) if model.memory_element().is_some() => (None, None),
             Some(options) => match options.compute(model, &sol) {
                 Ok(f) => (Some(f), None),
                 Err(e) => (None, Some(format!("stability at Ω = {omega}: {e}"))),

@@ -13,7 +13,8 @@
 //! [`MeshStiffness`] (`mesh_stiffness`), [`Backlash`] (`backlash`), [`CubicSpring`]
 //! (`cubic_spring`), [`GapContact`] (`gap_contact`), [`StopSpring`] (`stop_spring`),
 //! [`Friction`] (`friction`), [`QuadraticDamper`] (`quadratic_damper`),
-//! [`PolynomialSpring`] (`polynomial_spring`). Any law acts on a shifted coordinate
+//! [`PolynomialSpring`] (`polynomial_spring`), and with memory [`Jenkins`] (`jenkins`, see
+//! [`memory`]). Any law acts on a shifted coordinate
 //! `u - u0` through [`Offset`] (the element field `offset` in a scene file). Implement
 //! [`ForceLaw`] in your own crate for anything else and check its derivatives with
 //! [`check_derivatives`].
@@ -23,7 +24,9 @@ mod check;
 mod cubic_spring;
 mod friction;
 mod gap_contact;
+mod jenkins;
 mod linear_spring;
+pub mod memory;
 mod mesh_stiffness;
 mod offset;
 mod polynomial_spring;
@@ -36,7 +39,9 @@ pub use check::{check_derivatives, DerivativeCheck};
 pub use cubic_spring::CubicSpring;
 pub use friction::Friction;
 pub use gap_contact::{ContactState, GapContact};
+pub use jenkins::Jenkins;
 pub use linear_spring::LinearSpring;
+pub use memory::{Hysteresis, StepDerivatives, MAX_STATE};
 pub use mesh_stiffness::MeshStiffness;
 pub use offset::Offset;
 pub use polynomial_spring::PolynomialSpring;
@@ -197,6 +202,18 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
     /// period spent in each. Default: none (reports number the intervals instead).
     fn state_names(&self) -> &'static [&'static str] {
         &[]
+    }
+
+    /// The memory of a hysteretic law (a friction slider), `None` (the default) for a law
+    /// whose force depends only on `(θ, u, u̇)`.
+    ///
+    /// With memory, the AFT marches the samples of a period through
+    /// [`Hysteresis::step`] until the loop closes and chains its derivatives for the Jacobian;
+    /// the time-domain reference commits the state after every step; the Floquet analysis
+    /// refuses the model. [`ForceLaw::force`] and [`ForceLaw::derivatives`] are then only the
+    /// first step from the initial state. See [`memory`].
+    fn memory(&self) -> Option<&dyn Hysteresis> {
+        None
     }
 
     /// `true` if the force is exactly `k0 u + d0 u̇` at all times: the element then lives

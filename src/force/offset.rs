@@ -1,5 +1,6 @@
 //! `offset`: any law on a shifted coordinate, `f = law(θ, u - u0, u̇)`.
 
+use super::memory::{Hysteresis, StepDerivatives};
 use super::{ForceLaw, LinearPart};
 use crate::error::{check_finite, Result};
 
@@ -15,7 +16,7 @@ const CHUNK: usize = 64;
 ///
 /// Everything the law declares moves with it: its linear part
 /// `f ≈ f0 + k0 (u - u0) + d0 u̇` becomes the offset `f0 - k0 u0` with the same `(k0, d0)`,
-/// its kinks move by `+u0`; time variation, band limiting and validation are the law's own. A
+/// its kinks move by `+u0`, its memory (if any) steps on `u - u0`; time variation, band limiting and validation are the law's own. A
 /// linear law stays linear time-invariant: the static force `f0 - k0 u0` is a constant load
 /// of the split (see [`LinearPart`]).
 ///
@@ -120,6 +121,11 @@ impl ForceLaw for Offset {
     fn state_names(&self) -> &'static [&'static str] {
         self.law.state_names()
     }
+
+    fn memory(&self) -> Option<&dyn Hysteresis> {
+        // The law's memory on the shifted coordinate: `self` forwards the steps.
+        self.law.memory().map(|_| self as &dyn Hysteresis)
+    }
     fn is_linear_time_invariant(&self) -> bool {
         // Exact: f = k0 (u - u0) + d0 u̇ + f0 = k0 u + d0 u̇ + (f0 - k0 u0), and the residual
         // carries every element's static offset as a load (also for LTI elements).
@@ -128,5 +134,42 @@ impl ForceLaw for Offset {
     fn validate(&self, context: &str) -> Result<()> {
         check_finite(context, "offset", self.offset)?;
         self.law.validate(context)
+    }
+}
+
+/// The memory of the wrapped law on `u - u0`. Only reached through [`ForceLaw::memory`], which
+/// returns it when the wrapped law has memory.
+impl Hysteresis for Offset {
+    fn state_len(&self) -> usize {
+        self.law.memory().map_or(0, |m| m.state_len())
+    }
+    fn initial_state(&self, state: &mut [f64]) {
+        if let Some(m) = self.law.memory() {
+            m.initial_state(state);
+        }
+    }
+    #[inline]
+    fn step(&self, theta: f64, u: f64, du: f64, state: &mut [f64]) -> f64 {
+        match self.law.memory() {
+            Some(m) => m.step(theta, u - self.offset, du, state),
+            None => self.law.force(theta, u - self.offset, du),
+        }
+    }
+    #[inline]
+    fn step_derivatives(
+        &self,
+        theta: f64,
+        u: f64,
+        du: f64,
+        state: &mut [f64],
+        d: &mut StepDerivatives,
+    ) -> f64 {
+        match self.law.memory() {
+            Some(m) => m.step_derivatives(theta, u - self.offset, du, state, d),
+            None => {
+                (d.df_du, d.df_ddu) = self.law.derivatives(theta, u - self.offset, du);
+                self.law.force(theta, u - self.offset, du)
+            }
+        }
     }
 }

@@ -12,6 +12,7 @@ mod aft;
 mod basis;
 mod dynamic_stiffness;
 pub mod kinks;
+pub mod march;
 mod packing;
 
 pub use aft::{AftPlan, AftScratch};

@@ -141,6 +141,12 @@ impl Model {
         &self.elements
     }
 
+    /// The first element whose law has memory ([`ForceLaw::memory`](crate::force::ForceLaw::memory)),
+    /// if any: the Floquet analysis is not available for such a model.
+    pub fn memory_element(&self) -> Option<&Element> {
+        self.elements.iter().find(|e| e.law().memory().is_some())
+    }
+
     /// `K0 = K + Σ_e k0_e w_e w_eᵀ`, the constant stiffness of the paper's split.
     pub fn k0(&self) -> SparseMatrix {
         self.stiffness.plus_outer(

@@ -131,9 +131,30 @@ pub fn element_outputs(model: &Model, sol: &Solution) -> Result<Vec<ElementOutpu
         // Extremes from the law itself; harmonics from the copy the AFT balanced (a
         // time-varying stiffness band-limited to 2H orders), so that the mean force is the
         // one of the static balance.
-        e.law().force_batch(&theta, &u, &du, &mut f);
+        if let Some(memory) = e.law().memory() {
+            // A law with memory: march the period until its hysteresis loop closes.
+            let mut buffers = crate::harmonic::march::MarchBuffers::new(samples, 0);
+            crate::harmonic::march::march(
+                memory,
+                &theta,
+                &u,
+                &du,
+                &mut f,
+                0,
+                |_, _| (0.0, 0.0),
+                &mut buffers,
+            )
+            .map_err(|_| crate::Error::Solver {
+                reason: format!(
+                    "element `{}`: its hysteresis loop does not close over the period",
+                    e.name()
+                ),
+            })?;
+        } else {
+            e.law().force_batch(&theta, &u, &du, &mut f);
+        }
         let (fmin, fmax) = min_max(&f);
-        if let Some(balanced) = e.law().band_limited(samples, 2 * h) {
+        if let (None, Some(balanced)) = (e.law().memory(), e.law().band_limited(samples, 2 * h)) {
             balanced.force_batch(&theta, &u, &du, &mut f);
         }
         if let Some(j) = f.iter().position(|x| !x.is_finite()) {

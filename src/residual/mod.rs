@@ -16,6 +16,7 @@ use crate::linear::Formulation;
 use crate::model::Model;
 
 mod condensed;
+mod memory;
 use crate::solution::SolveStats;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -70,6 +71,8 @@ pub struct HarmonicBalance<'m> {
     condensed: Option<Box<(crate::linear::Condensation, Vec<Complex64>)>>,
     /// Rigid-body modes of a free-free model (full formulation: `Z_0 = K0 + s M R Rᵀ M`).
     rigid: Option<std::sync::Arc<crate::model::RigidModes>>,
+    /// `cos`, `sin` of `2π m / N` for the Jacobian of laws with memory (empty without them).
+    trig: Vec<(f64, f64)>,
 }
 
 /// A time-varying or nonlinear element, the law the AFT evaluates for it (its band-limited
@@ -100,6 +103,10 @@ pub struct AftBuffers {
     spec_du: Vec<Complex64>,
     jac_scratch: crate::jacobian::JacobianScratch,
     crossings: Vec<crate::harmonic::kinks::Crossing>,
+    /// Sensitivities of the march of laws with memory (empty without them).
+    march: crate::harmonic::march::MarchBuffers,
+    /// One local Jacobian column (laws with memory).
+    column: Vec<f64>,
     /// Real FFTs done so far.
     pub ffts: usize,
     /// Force-law calls so far.
@@ -213,15 +220,26 @@ impl<'m> HarmonicBalance<'m> {
                     .collect();
                 jump_samples.sort_unstable();
                 jump_samples.dedup();
+                // A law with memory is marched (no kink quadrature, no time jumps).
+                if law.memory().is_some() {
+                    jump_samples.clear();
+                }
                 ActiveElement {
                     index,
                     weights: e.weights().to_vec(),
-                    kinks: law.kinks(),
+                    kinks: if law.memory().is_some() {
+                        Vec::new()
+                    } else {
+                        law.kinks()
+                    },
                     band_limited,
                     jump_samples,
                 }
             })
-            .collect();
+            .collect::<Vec<ActiveElement>>();
+        let has_memory = active
+            .iter()
+            .any(|a| model.elements()[a.index].law().memory().is_some());
         let mut hb = Self {
             model,
             basis,
@@ -236,6 +254,11 @@ impl<'m> HarmonicBalance<'m> {
             names: model.dof_names().to_vec(),
             condensed: None,
             rigid: None,
+            trig: if has_memory {
+                memory::trig_table(samples)
+            } else {
+                Vec::new()
+            },
         };
         let mean_load: Vec<f64> = hb.f_ext[..n].iter().map(|v| v.re).collect();
         match formulation.resolve(model) {
@@ -334,6 +357,12 @@ impl<'m> HarmonicBalance<'m> {
                 spec_du: vec![Complex64::default(); s / 2 + 1],
                 jac_scratch: crate::jacobian::JacobianScratch::new(h),
                 crossings: Vec::with_capacity(16),
+                march: if self.trig.is_empty() {
+                    Default::default()
+                } else {
+                    crate::harmonic::march::MarchBuffers::new(s, 2 * h + 1)
+                },
+                column: vec![0.0; if self.trig.is_empty() { 0 } else { 2 * h + 1 }],
                 ffts: 0,
                 force_evaluations: 0,
             },
@@ -373,6 +402,10 @@ impl<'m> HarmonicBalance<'m> {
             self.element_samples(act, q, ws);
             let law = self.law(act);
             let lin = e.linear_part();
+            if let Some(m) = law.memory() {
+                self.memory_rest(act, m, &lin, out, jac.as_deref_mut(), ws)?;
+                continue;
+            }
             law.force_batch(&self.thetas, &ws.u, &ws.du, &mut ws.f);
             for ((f, &u), &du) in ws.f.iter_mut().zip(&ws.u).zip(&ws.du) {
                 *f -= lin.offset + lin.stiffness * u + lin.damping * du;
@@ -492,10 +525,14 @@ impl<'m> HarmonicBalance<'m> {
         for act in &self.active {
             let e = &self.model.elements()[act.index];
             self.element_samples(act, &ws.q, b);
-            self.derivative_samples(act, b);
-            let d0 = e.linear_part().damping;
-            for ((f, g), du) in b.f.iter_mut().zip(&b.gdu).zip(&b.du) {
-                *f = (g - d0) * du / omega;
+            if let Some(m) = self.law(act).memory() {
+                self.memory_omega_derivative(act, m, b)?;
+            } else {
+                self.derivative_samples(act, b);
+                let d0 = e.linear_part().damping;
+                for ((f, g), du) in b.f.iter_mut().zip(&b.gdu).zip(&b.du) {
+                    *f = (g - d0) * du / omega;
+                }
             }
             if !b.f.iter().all(|v| v.is_finite()) {
                 return Err(Error::NonFinite {

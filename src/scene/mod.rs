@@ -303,7 +303,7 @@ pub fn set_parameter(doc: &mut Value, path: &str, x: f64) -> Result<(), String> 
 
 /// The built-in element types (users' laws compiled in are accepted too).
 pub fn known_types() -> String {
-    "linear_spring, mesh_stiffness, backlash, cubic_spring, gap_contact, stop_spring, friction, \
+    "linear_spring, mesh_stiffness, backlash, cubic_spring, gap_contact, stop_spring, friction, jenkins, \
      quadratic_damper, polynomial_spring, gear_stage"
         .to_string()
 }

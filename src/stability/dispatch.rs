@@ -93,6 +93,14 @@ impl FloquetOptions {
                 "positive (a multiple of the highest harmonic's frequency)",
             ));
         }
+        // The variational equation of a law with memory is not the one of `(∂f/∂u, ∂f/∂u̇)`:
+        // refuse rather than give wrong multipliers.
+        if let Some(e) = model.memory_element() {
+            return Err(Error::MemoryUnsupported {
+                analysis: "stability".into(),
+                element: e.name().to_string(),
+            });
+        }
         let n = model.n_dofs();
         if solution.harmonics().len() < n || solution.dof_names().len() != n {
             return Err(Error::DimensionMismatch {

@@ -11,8 +11,11 @@
 //! ([`ForceLaw::time_breakpoints`](crate::force::ForceLaw::time_breakpoints)), and inside a
 //! segment the laws see angles clamped to it, so a rectangular mesh stiffness is integrated
 //! exactly piecewise. State-dependent kinks (backlash contact) are left to the error control;
-//! tighten `rtol` (or limit the step with `max_step`) to check them.
+//! tighten `rtol` (or limit the step with `max_step`) to check them. Laws with memory
+//! (a Jenkins slider) keep their state frozen over a step and commit it after the step, with a
+//! restart where the frozen state stops being the true one (the module `timesim::memory` in the source).
 
+mod memory;
 mod rhs;
 
 use crate::error::{Error, Result};
@@ -278,51 +281,64 @@ impl TimeSimulation {
                 method = method.h_max(h * period);
             }
             let y0 = y.clone();
-            let (t_end, y_end) = match samples.as_deref_mut() {
-                None => {
-                    let sol = IVP::ode(rhs, ta, tb, y0)
-                        .method(method)
-                        .solout(LastPoint::new(tb))
-                        .solve()
-                        .map_err(|e| Error::TimeIntegration {
-                            reason: format!("{e:?}"),
+            let (t_end, y_end) = if rhs.has_memory() {
+                memory::integrate_segment(
+                    rhs,
+                    (self.rtol, atol, self.max_step.map(|h| h * period)),
+                    (ta, tb),
+                    (w[0], w[1], t_period, omega),
+                    y0,
+                    samples.as_deref_mut(),
+                    steps,
+                    evals,
+                )?
+            } else {
+                match samples.as_deref_mut() {
+                    None => {
+                        let sol = IVP::ode(rhs, ta, tb, y0)
+                            .method(method)
+                            .solout(LastPoint::new(tb))
+                            .solve()
+                            .map_err(|e| Error::TimeIntegration {
+                                reason: format!("{e:?}"),
+                            })?;
+                        *steps += sol.steps.accepted + sol.steps.rejected;
+                        *evals += sol.evals.function;
+                        let (t, y) = sol.last().map_err(|e| Error::TimeIntegration {
+                            reason: e.to_string(),
                         })?;
-                    *steps += sol.steps.accepted + sol.steps.rejected;
-                    *evals += sol.evals.function;
-                    let (t, y) = sol.last().map_err(|e| Error::TimeIntegration {
-                        reason: e.to_string(),
-                    })?;
-                    (*t, y.clone())
-                }
-                Some(out) => {
-                    let ns = out[0].len();
-                    let js: Vec<usize> = (0..ns)
-                        .filter(|&j| {
-                            let th = TAU * j as f64 / ns as f64;
-                            th >= w[0] && th < w[1]
-                        })
-                        .collect();
-                    let mut ts: Vec<f64> = js
-                        .iter()
-                        .map(|&j| t_period + TAU * j as f64 / ns as f64 / omega)
-                        .collect();
-                    ts.push(tb);
-                    let sol = IVP::ode(rhs, ta, tb, y0)
-                        .method(method)
-                        .t_eval(&ts)
-                        .solve()
-                        .map_err(|e| Error::TimeIntegration {
-                            reason: format!("{e:?}"),
-                        })?;
-                    for (&j, yj) in js.iter().zip(&sol.y) {
-                        for (i, row) in out.iter_mut().enumerate() {
-                            row[j] = yj[i];
-                        }
+                        (*t, y.clone())
                     }
-                    let (t, y) = sol.last().map_err(|e| Error::TimeIntegration {
-                        reason: e.to_string(),
-                    })?;
-                    (*t, y.clone())
+                    Some(out) => {
+                        let ns = out[0].len();
+                        let js: Vec<usize> = (0..ns)
+                            .filter(|&j| {
+                                let th = TAU * j as f64 / ns as f64;
+                                th >= w[0] && th < w[1]
+                            })
+                            .collect();
+                        let mut ts: Vec<f64> = js
+                            .iter()
+                            .map(|&j| t_period + TAU * j as f64 / ns as f64 / omega)
+                            .collect();
+                        ts.push(tb);
+                        let sol = IVP::ode(rhs, ta, tb, y0)
+                            .method(method)
+                            .t_eval(&ts)
+                            .solve()
+                            .map_err(|e| Error::TimeIntegration {
+                                reason: format!("{e:?}"),
+                            })?;
+                        for (&j, yj) in js.iter().zip(&sol.y) {
+                            for (i, row) in out.iter_mut().enumerate() {
+                                row[j] = yj[i];
+                            }
+                        }
+                        let (t, y) = sol.last().map_err(|e| Error::TimeIntegration {
+                            reason: e.to_string(),
+                        })?;
+                        (*t, y.clone())
+                    }
                 }
             };
             if (t_end - tb).abs() > 1e-9 * period {

@@ -1,6 +1,10 @@
 //! The first-order right-hand side `y = (q, q̇)`, `ẏ = (q̇, M⁻¹(f - D q̇ - K q - Σ w f_e))`.
+//!
+//! A law with memory is evaluated by its step from the state committed after the last accepted
+//! step, without committing (the state is frozen over a step; see [`super::memory`]).
 
 use crate::error::{Error, Result};
+use crate::force::MAX_STATE;
 use crate::model::Model;
 use differential_equations::prelude::*;
 use nalgebra::{Cholesky, DVector, Dyn};
@@ -13,6 +17,10 @@ pub(super) struct Rhs<'m> {
     /// (t_a, θ_a, θ_lo, θ_hi) of the current segment.
     segment: Cell<(f64, f64, f64, f64)>,
     acc: RefCell<DVector<f64>>,
+    /// The committed state of every element with memory (unused entries for the others).
+    pub(super) states: RefCell<Vec<[f64; MAX_STATE]>>,
+    /// `true` if an element has memory.
+    memory: bool,
 }
 
 impl<'m> Rhs<'m> {
@@ -24,13 +32,42 @@ impl<'m> Rhs<'m> {
             .ok_or_else(|| Error::MassNotPositiveDefinite {
                 reason: "Cholesky factorisation failed".into(),
             })?;
+        let states = model
+            .elements()
+            .iter()
+            .map(|e| {
+                let mut s = [0.0; MAX_STATE];
+                if let Some(m) = e.law().memory() {
+                    m.initial_state(&mut s[..m.state_len()]);
+                }
+                s
+            })
+            .collect();
         Ok(Self {
             model,
+            states: RefCell::new(states),
+            memory: model.memory_element().is_some(),
             chol,
             omega,
             segment: Cell::new((0.0, 0.0, 0.0, std::f64::consts::TAU)),
             acc: RefCell::new(DVector::zeros(model.n_dofs())),
         })
+    }
+
+    /// The model.
+    pub(super) fn model(&self) -> &'m Model {
+        self.model
+    }
+
+    /// `true` if an element's law has memory.
+    pub(super) fn has_memory(&self) -> bool {
+        self.memory
+    }
+
+    /// The angle θ the laws see at time `t` (clamped inside the current segment).
+    pub(super) fn theta(&self, t: f64) -> f64 {
+        let (ta, tha, lo, hi) = self.segment.get();
+        (tha + self.omega * (t - ta)).clamp(lo, hi)
     }
 
     /// The next calls see angles `θ = θ_a + Ω (t - t_a)` clamped inside `[θ_a, θ_b]`, so the
@@ -46,16 +83,23 @@ impl ODE<f64, Vec<f64>> for Rhs<'_> {
     fn diff(&self, t: f64, y: &Vec<f64>, dydt: &mut Vec<f64>) {
         let n = self.model.n_dofs();
         let (q, v) = y.split_at(n);
-        let (ta, tha, lo, hi) = self.segment.get();
-        let theta = (tha + self.omega * (t - ta)).clamp(lo, hi);
+        let theta = self.theta(t);
+        let states = self.states.borrow();
         let mut a = self.acc.borrow_mut();
         a.fill(0.0);
         self.model.load_into(theta, a.as_mut_slice());
         let a_slice = a.as_mut_slice();
         self.model.structural_damping().mul_add(-1.0, v, a_slice);
         self.model.structural_stiffness().mul_add(-1.0, q, a_slice);
-        for e in self.model.elements() {
-            let f = e.law().force(theta, e.gather(q), e.gather(v));
+        for (e, s) in self.model.elements().iter().zip(states.iter()) {
+            let (u, du) = (e.gather(q), e.gather(v));
+            let f = match e.law().memory() {
+                None => e.law().force(theta, u, du),
+                Some(m) => {
+                    let mut frozen = *s;
+                    m.step(theta, u, du, &mut frozen[..m.state_len()])
+                }
+            };
             e.scatter_add(-f, a.as_mut_slice());
         }
         self.chol.solve_mut(&mut *a);
