@@ -121,3 +121,66 @@ fn backlash_contact_states_with_contact_loss() {
     // No force while open: the force's minimum over the period is 0 or below (coast impacts).
     assert!(c.force.min <= 1e-12);
 }
+
+/// `hbal solve --json --out`: the elements in the JSON (harmonic and order, the gear stage's
+/// mesh output) and in `elements.csv`, quoted where a name holds a comma.
+#[test]
+fn cli_writes_element_outputs() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/two_shaft_gear_pair.toml"),
+    )
+    .unwrap()
+    .replace("name = \"mesh\"", "name = \"mesh, stage 1\"")
+    .replace(
+        "fundamental = { rpm = 3000 }",
+        "fundamental = { rpm = 1500, order = 2 }",
+    );
+    let dir = std::env::temp_dir().join(format!("hbal-elements-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("pair.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out_dir = dir.join("out");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args([
+            "solve",
+            scene.to_str().unwrap(),
+            "--json",
+            "--no-stability",
+            "--out",
+        ])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let e = &doc["elements"][0];
+    assert_eq!(e["name"], "mesh, stage 1");
+    assert_eq!(e["type"], "gear_stage");
+    // Harmonic 20 of a fundamental of order 2 is order 40 of the 1500 rpm reference.
+    let h20 = &e["force"]["harmonics"][20];
+    assert_eq!(h20["harmonic"], 20);
+    assert_eq!(h20["order"], 40.0);
+    let m = &e["gear_stage"];
+    assert_eq!(m["te_unit"], "µm");
+    assert!(m["dynamic_factor"].as_f64().unwrap() > 1.0);
+    let csv = std::fs::read_to_string(out_dir.join("elements.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("element,quantity,harmonic,order,cos,sin")
+    );
+    let first = lines.next().unwrap();
+    assert!(first.starts_with("\"mesh, stage 1\",u,0,0,"), "{first}");
+    let mut reader = csv::Reader::from_reader(csv.as_bytes());
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    assert_eq!(rows.len(), 2 * 65);
+    assert!(rows
+        .iter()
+        .all(|r| r.len() == 6 && &r[0] == "mesh, stage 1"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

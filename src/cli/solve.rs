@@ -2,7 +2,7 @@
 //! `--start` file, compute the orbit's Floquet stability, print a summary or one JSON object, and
 //! optionally write harmonics.csv, time_series.csv and SVG plots.
 
-use super::{load, multipliers_json, start, Failure, SolverArgs};
+use super::{element_report, load, multipliers_json, start, Failure, SolverArgs};
 use anyhow::Context;
 use hbal::report::{line_plot, Axis, Series};
 use hbal::stability::Floquet;
@@ -104,6 +104,9 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         });
     let stability_seconds = started.elapsed().as_secs_f64();
     let max_abs = sol.max_abs_all();
+    let elements = hbal::report::element_outputs(&scene.model, &sol).map_err(|e| e.to_string());
+    let subharmonic = sol.basis().subharmonic();
+    let order = |k| element_report::order_of(k, scene.fundamental_order, subharmonic);
     let dofs: Vec<_> = sol
         .dof_names()
         .iter()
@@ -161,6 +164,10 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             "start": opts.start.map(|p| p.display().to_string()),
             "stability": stability_json,
             "dofs": dofs,
+            "elements": match &elements {
+                Ok(e) => element_report::json(e, order),
+                Err(e) => json!({ "error": e }),
+            },
             "history": sol.history,
         });
         say!("{doc}");
@@ -204,6 +211,10 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         }
         for (i, name) in sol.dof_names().iter().enumerate() {
             say!("  max |q| {name}: {:.6e}", max_abs[i]);
+        }
+        match &elements {
+            Ok(e) => element_report::lines(e).iter().for_each(|l| say!("  {l}")),
+            Err(e) => say!("  element outputs: {e}"),
         }
         match &stability {
             None if opts.stability && unavailable.is_some() => {
@@ -260,9 +271,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     }
     if let Some(dir) = out {
         write_outputs(dir, &sol)?;
+        if let Ok(e) = &elements {
+            element_report::write_csv(&dir.join("elements.csv"), e, order)
+                .with_context(|| format!("--out: cannot write {}", dir.display()))?;
+        }
         if !as_json {
             say!(
-                "  wrote harmonics.csv, time_series.csv, time_series.svg, spectrum.svg to {}",
+                "  wrote harmonics.csv, elements.csv, time_series.csv, time_series.svg, spectrum.svg to {}",
                 dir.display()
             );
         }
