@@ -333,3 +333,60 @@ fn condensed_parameter_sweep_equals_full() {
     let ratio = first(3) / first(0);
     assert!(ratio > 1.5 && ratio < 4.0, "{ratio}");
 }
+
+/// A split power path (input -> two countershafts -> output) closes a loop of meshes: the four
+/// mesh coordinates are linearly dependent. `auto` then holds the problem in the full
+/// formulation; an explicit `condensed` says why it cannot.
+#[test]
+fn auto_falls_back_to_full_on_dependent_mesh_coordinates() {
+    let names = ["e1", "e2", "a", "b", "c", "d", "o1", "o2"];
+    let mut builder = Model::builder(&names)
+        .mass_diagonal(&[0.1, 0.05, 0.01, 0.01, 0.01, 0.01, 0.05, 0.2])
+        .stiffness(DMatrix::from_fn(8, 8, |i, j| {
+            // Shafts e1-e2-a and d-o1-o2, a soft ground spring on o2.
+            let k = 1e4;
+            let pairs = [(0, 1), (1, 2), (5, 6), (6, 7)];
+            let mut v = 0.0;
+            for &(p, q) in &pairs {
+                if (i, j) == (p, q) || (i, j) == (q, p) {
+                    v -= k;
+                }
+                if i == j && (i == p || i == q) {
+                    v += k;
+                }
+            }
+            if i == 7 && j == 7 {
+                v += 1e3;
+            }
+            v
+        }))
+        .damping(DMatrix::from_diagonal_element(8, 8, 0.5))
+        .load("e1", 1, 5.0, 0.0);
+    let mesh = || {
+        MeshStiffness::new(
+            3,
+            MeshProfile::Cosine {
+                mean: 1e5,
+                amplitude: 1e4,
+            },
+            MeshDamping::Constant(1.0),
+        )
+    };
+    for (name, p, q) in [
+        ("ab", "a", "b"),
+        ("bd", "b", "d"),
+        ("ac", "a", "c"),
+        ("cd", "c", "d"),
+    ] {
+        builder = builder.element(name, &[(p, 1.0), (q, -1.0)], mesh());
+    }
+    let model = builder.build().unwrap();
+    assert_eq!(Formulation::Auto.resolve(&model), Formulation::Condensed);
+    let basis = HarmonicBasis::new(50.0, 8).unwrap();
+    let hb = HarmonicBalance::with_formulation(&model, basis, Formulation::Auto).unwrap();
+    assert_eq!(hb.formulation(), Formulation::Full);
+    let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
+    assert!(sol.is_converged());
+    let err = HarmonicBalance::with_formulation(&model, basis, Formulation::Condensed).unwrap_err();
+    assert!(err.to_string().contains("linearly dependent"), "{err}");
+}

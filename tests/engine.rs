@@ -176,6 +176,19 @@ orders = [{ order = 0.5, amplitude = 10.0 }, { order = 2.0, amplitude = 60.0 }]
 fn scene_chooses_a_fundamental_that_holds_half_orders() {
     let s = Scene::from_str(SCENE, "engine.toml").unwrap();
     assert!((s.basis.omega() - 0.5 * 3000.0 * 2.0 * PI / 60.0).abs() < 1e-9);
+    assert!(s.notes.is_empty());
+    // A `loads` entry of order >= 1 now counts half orders: the scene says so.
+    let with_load = SCENE.replace(
+        "harmonics = { count = 8 }",
+        "harmonics = { count = 8 }\nloads = [{ dof = \"flywheel\", order = 2, cos = 1.0 }]",
+    );
+    let noted = Scene::from_str(&with_load, "engine.toml").unwrap();
+    assert_eq!(noted.notes.len(), 1);
+    assert!(
+        noted.notes[0].contains("shaft order 1"),
+        "{}",
+        noted.notes[0]
+    );
     let loads = s.model.loads();
     let order2: f64 = loads.iter().filter(|l| l.order == 4).map(|l| l.cos).sum();
     assert!((order2 - 240.0).abs() < 1e-12, "{order2}");
@@ -268,4 +281,45 @@ fn bad_engine_tables_name_the_field() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("firing_order"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A gear stage whose mesh order is a half order of the reference (21 teeth at half the crank
+/// speed: 10.5) is a harmonic of the automatic fundamental of order 0.5: 21 mesh cycles per
+/// period.
+#[test]
+fn gear_stage_half_mesh_orders_set_the_fundamental() {
+    let text = format!(
+        "{SCENE}
+[[elements]]
+name = \"stage\"
+type = \"gear_stage\"
+driving = \"engine\"
+driven = \"flywheel\"
+base_radii = [0.02, 0.04]
+teeth = 21
+shaft_order = 0.5
+stiffness = {{ shape = \"constant\", stiffness = 1e8 }}
+"
+    )
+    .replace(
+        "orders = [{ order = 0.5, amplitude = 10.0 }, { order = 2.0, amplitude = 60.0 }]",
+        "orders = [{ order = 2.0, amplitude = 60.0 }]",
+    )
+    .replace("harmonics = { count = 8 }", "harmonics = { count = 24 }");
+    let s = Scene::from_str(&text, "stage.toml").unwrap();
+    assert_eq!(s.fundamental_order, 0.5);
+    let stage = s.model.elements()[0].gear_stage().unwrap();
+    assert_eq!(stage.mesh_order(), Some(21));
+    // With `fundamental.order = 1` the half mesh order is refused at the stage's field.
+    let err = Scene::from_str(
+        &text.replace("{ rpm = 3000 }", "{ rpm = 3000, order = 1 }"),
+        "stage.toml",
+    )
+    .unwrap_err();
+    assert_eq!(
+        err.path.as_deref(),
+        Some("elements[0].shaft_order"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("fundamental's order 1"), "{err}");
 }

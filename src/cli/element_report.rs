@@ -1,6 +1,6 @@
 //! Element outputs of `hbal solve` ([`hbal::report::element_outputs`]) as text lines, JSON
-//! and `elements.csv`; every harmonic is named by its index k and by the order it is of the
-//! scene's reference speed.
+//! and `elements.csv`; every harmonic is named by its index k (`harmonic`) and by the order it
+//! is of the scene's reference speed (`shaft_order`; the DOFs' `order` is the index k).
 
 use hbal::report::{ElementOutput, Signal};
 use serde_json::{json, Value};
@@ -19,7 +19,7 @@ fn signal_json(s: &Signal, order: impl Fn(usize) -> f64) -> Value {
         "peak_to_peak": s.peak_to_peak(),
         "harmonics": s.harmonics.iter().enumerate().map(|(k, x)| {
             let (c, sn) = hbal::harmonic::cos_sin(*x);
-            json!({"harmonic": k, "order": order(k), "cos": c, "sin": sn})
+            json!({"harmonic": k, "shaft_order": order(k), "cos": c, "sin": sn})
         }).collect::<Vec<_>>(),
     })
 }
@@ -82,7 +82,7 @@ pub(crate) fn lines(outputs: &[ElementOutput]) -> Vec<String> {
         .collect()
 }
 
-/// `elements.csv`: `element,quantity,harmonic,order,cos,sin` for the coordinate `u` and the
+/// `elements.csv`: `element,quantity,harmonic,shaft_order,cos,sin` for the coordinate `u` and the
 /// force `f` of every element (quoted where a name needs it).
 pub(crate) fn write_csv(
     path: &Path,
@@ -90,7 +90,14 @@ pub(crate) fn write_csv(
     order: impl Fn(usize) -> f64,
 ) -> anyhow::Result<()> {
     let mut w = csv::Writer::from_path(path)?;
-    w.write_record(["element", "quantity", "harmonic", "order", "cos", "sin"])?;
+    w.write_record([
+        "element",
+        "quantity",
+        "harmonic",
+        "shaft_order",
+        "cos",
+        "sin",
+    ])?;
     for e in outputs {
         for (quantity, s) in [("u", &e.coordinate), ("f", &e.force)] {
             for (k, x) in s.harmonics.iter().enumerate() {

@@ -122,6 +122,9 @@ impl SolverArgs {
 /// Loads the scene and applies the command-line overrides.
 pub(crate) fn load(path: &Path, args: &SolverArgs) -> Result<Scene, Failure> {
     let mut scene = Scene::load(path)?;
+    for note in &scene.notes {
+        eprintln!("note: {}: {note}", scene.file);
+    }
     if let Some(name) = &args.method {
         scene.method = scene.method_named(name)?;
     }

@@ -303,37 +303,40 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
 fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let h = sol.basis().harmonics();
-    let mut csv = String::from("dof,order,cos,sin\n");
+    // CSV through the csv writer: a DOF name with a comma or a quote is quoted.
+    let mut w = csv::Writer::from_path(dir.join("harmonics.csv"))?;
+    w.write_record(["dof", "order", "cos", "sin"])?;
     for (i, name) in sol.dof_names().iter().enumerate() {
         for k in 0..=h {
             let (c, s) = sol.cos_sin(i, k);
-            csv.push_str(&format!("{name},{k},{c:e},{s:e}\n"));
+            w.write_record([
+                name.clone(),
+                k.to_string(),
+                format!("{c:e}"),
+                format!("{s:e}"),
+            ])?;
         }
     }
-    std::fs::write(dir.join("harmonics.csv"), csv)?;
+    w.flush()?;
     let points = sol.basis().samples().max(256);
     let period = sol.basis().period();
     let series: Vec<Vec<f64>> = (0..sol.dof_names().len())
         .map(|i| sol.time_series(i, points))
         .collect();
-    let mut csv = String::from("t,theta");
-    for name in sol.dof_names() {
-        csv.push_str(&format!(",{name}"));
-    }
-    csv.push('\n');
+    let mut w = csv::Writer::from_path(dir.join("time_series.csv"))?;
+    let mut header = vec!["t".to_string(), "theta".to_string()];
+    header.extend(sol.dof_names().iter().cloned());
+    w.write_record(&header)?;
     for j in 0..points {
         let frac = j as f64 / points as f64;
-        csv.push_str(&format!(
-            "{:e},{:e}",
-            frac * period,
-            frac * std::f64::consts::TAU
-        ));
-        for s in &series {
-            csv.push_str(&format!(",{:e}", s[j]));
-        }
-        csv.push('\n');
+        let mut row = vec![
+            format!("{:e}", frac * period),
+            format!("{:e}", frac * std::f64::consts::TAU),
+        ];
+        row.extend(series.iter().map(|s| format!("{:e}", s[j])));
+        w.write_record(&row)?;
     }
-    std::fs::write(dir.join("time_series.csv"), csv)?;
+    w.flush()?;
     let (shown, note) = plotted_dofs(sol, h);
     let names = sol.dof_names();
     let lines: Vec<Series> = shown

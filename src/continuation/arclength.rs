@@ -94,7 +94,7 @@ impl Continuation {
         let mut x = vec![0.0; m];
         // The solution carries all DOFs; the unknowns may be the element coordinates.
         let unknowns = hb
-            .unknowns_of(start.harmonics())
+            .unknowns_of_full(start.harmonics())
             .ok_or_else(|| Error::Solver {
                 reason: "continuation start: the solution does not match the discretisation".into(),
             })?;

@@ -129,7 +129,7 @@ impl Continuation {
         // the element coordinates when condensed).
         let pack = |q: &[Complex64]| {
             let embedded = crate::harmonic::embed(q, model.n_dofs(), ratio, basis.harmonics());
-            let unknowns = hb.unknowns_of(&embedded)?;
+            let unknowns = hb.unknowns_of_full(&embedded)?;
             let mut x = vec![0.0; m];
             layout.pack(&unknowns, &mut x);
             Some(x)
@@ -277,8 +277,10 @@ impl Continuation {
         let layout = hb.layout();
         let m = layout.len();
         let (mut xa, mut xb) = (vec![0.0; m], vec![0.0; m]);
-        let (Some(ua), Some(ub)) = (hb.unknowns_of(&a.harmonics), hb.unknowns_of(&b.harmonics))
-        else {
+        let (Some(ua), Some(ub)) = (
+            hb.unknowns_of_full(&a.harmonics),
+            hb.unknowns_of_full(&b.harmonics),
+        ) else {
             return Ok(None);
         };
         layout.pack(&ua, &mut xa);

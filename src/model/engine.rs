@@ -208,12 +208,12 @@ impl EngineExcitation {
         }
         check_finite(context, "mean_torque", self.mean_torque)?;
         for (i, o) in self.orders.iter().enumerate() {
-            if !(o.order.is_finite() && o.order > 0.0) {
+            if !(o.order.is_finite() && o.order > 0.0 && o.order <= 1e6) {
                 return Err(Error::invalid(
                     context,
                     format!("orders[{i}].order"),
                     o.order,
-                    "finite and > 0 (the mean is `mean_torque`)",
+                    "finite, > 0 and at most 1e6 (the mean is `mean_torque`)",
                 ));
             }
             check_non_negative(context, &format!("orders[{i}].amplitude"), o.amplitude)?;
@@ -275,22 +275,32 @@ impl EngineExcitation {
 /// The largest `f` of which every value is a whole multiple, as a fraction `p/q` with
 /// `q <= MAX_DENOMINATOR`; `None` if some value is not such a fraction (to 1e-9).
 pub(crate) fn common_divisor(values: impl Iterator<Item = f64>) -> Option<f64> {
+    // Orders up to 1e6 (beyond any engine or mesh order) keep the products below in u128.
+    const MAX_VALUE: f64 = 1e6;
     let mut fractions = Vec::new();
     for v in values {
+        if !(v.is_finite() && v > 0.0 && v <= MAX_VALUE) {
+            return None;
+        }
         let q = (1..=MAX_DENOMINATOR).find(|&q| {
             let p = v * q as f64;
             (p - p.round()).abs() <= 1e-9 * p.abs().max(1.0)
         })?;
         fractions.push(((v * q as f64).round() as u64, q));
     }
-    // gcd of p_i/q_i = gcd(p_i L/q_i) / L with L = lcm(q_i).
-    let l = fractions.iter().fold(1u64, |l, &(_, q)| l / gcd(l, q) * q);
-    if l > 1_000_000_000 {
-        return None;
+    // gcd of p_i/q_i = gcd(p_i L/q_i) / L with L = lcm(q_i) (at most 1e9: else no fundamental
+    // a harmonic basis could use).
+    let mut l = 1u64;
+    for &(_, q) in &fractions {
+        l = l / gcd(l, q) * q;
+        if l > 1_000_000_000 {
+            return None;
+        }
     }
-    let g = fractions
-        .iter()
-        .fold(0u64, |g, &(p, q)| gcd(g, p * (l / q)));
+    let g = fractions.iter().fold(0u64, |g, &(p, q)| {
+        // p <= 1e9 and L/q <= 1e9: the product fits in u64.
+        gcd(g, p * (l / q))
+    });
     (g > 0).then(|| g as f64 / l as f64)
 }
 

@@ -3,7 +3,6 @@
 
 use super::{line_plot, Axis, Series};
 use crate::continuation::Branch;
-use std::fmt::Write;
 use std::path::Path;
 
 /// CSV of a branch: parameter, stability, fold and bifurcation marks, `max|q|` per DOF, the
@@ -15,19 +14,30 @@ use std::path::Path;
 /// unless the point closes one) and the point's error estimate (empty if not computed). `parameter(p)` maps the point's swept parameter and the fold position to
 /// the parameter's unit (e.g. Ω to rpm).
 pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
-    let mut s = String::new();
-    let _ = write!(s, "{parameter_name},stable,fold,bifurcation");
+    let mut header: Vec<String> = [parameter_name, "stable", "fold", "bifurcation"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    header.extend(branch.dofs.iter().map(|d| format!("max_abs_{d}")));
     for d in &branch.dofs {
-        let _ = write!(s, ",max_abs_{d}");
+        header.extend((0..=branch.harmonics).map(|k| format!("amp_{d}_{k}")));
     }
-    for d in &branch.dofs {
-        for k in 0..=branch.harmonics {
-            let _ = write!(s, ",amp_{d}_{k}");
-        }
-    }
-    s.push_str(
-        ",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed,error_estimate\n",
+    header.extend(
+        [
+            "multipliers_abs",
+            "residual",
+            "truncation",
+            "fold_speed",
+            "spurious_turn",
+            "bifurcation_speed",
+            "error_estimate",
+        ]
+        .iter()
+        .map(|s| s.to_string()),
     );
+    // The csv writer quotes a field that needs it (a DOF name with a comma or a quote).
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let _ = w.write_record(&header);
     let n = branch.dofs.len();
     for p in &branch.points {
         let stable = match p.stable() {
@@ -35,43 +45,44 @@ pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64)
             Some(false) => "unstable",
             None => "",
         };
-        let bif = p.bifurcation.map(|b| format!("{b:?}")).unwrap_or_default();
-        let _ = write!(s, "{:e},{stable},{},{bif}", parameter(p.parameter), p.fold);
-        for m in &p.max_abs {
-            let _ = write!(s, ",{m:e}");
-        }
+        let mut row = vec![
+            format!("{:e}", parameter(p.parameter)),
+            stable.to_string(),
+            p.fold.to_string(),
+            p.bifurcation.map(|b| format!("{b:?}")).unwrap_or_default(),
+        ];
+        row.extend(p.max_abs.iter().map(|m| format!("{m:e}")));
         for i in 0..n {
-            for k in 0..=branch.harmonics {
-                let _ = write!(s, ",{:e}", p.harmonics[k * n + i].norm());
-            }
+            row.extend(
+                (0..=branch.harmonics).map(|k| format!("{:e}", p.harmonics[k * n + i].norm())),
+            );
         }
         let mult: Vec<String> = p
             .floquet
             .iter()
             .flat_map(|f| f.multipliers.iter().map(|m| format!("{:.6e}", m.norm())))
             .collect();
-        let fold_at = match (p.fold, p.fold_omega) {
+        row.push(mult.join(";"));
+        row.push(format!("{:e}", p.residual));
+        row.push(format!("{:e}", p.truncation));
+        row.push(match (p.fold, p.fold_omega) {
             (true, Some(w)) => format!("{:e}", parameter(w)),
             _ => String::new(),
-        };
-        let bif_at = p
-            .bifurcation_omega
-            .map(|w| format!("{:e}", parameter(w)))
-            .unwrap_or_default();
-        let est = p
-            .error_estimate
-            .map(|e| format!("{e:e}"))
-            .unwrap_or_default();
-        let _ = writeln!(
-            s,
-            ",{},{:e},{:e},{fold_at},{},{bif_at},{est}",
-            mult.join(";"),
-            p.residual,
-            p.truncation,
-            p.spurious_turn
+        });
+        row.push(p.spurious_turn.to_string());
+        row.push(
+            p.bifurcation_omega
+                .map(|w| format!("{:e}", parameter(w)))
+                .unwrap_or_default(),
         );
+        row.push(
+            p.error_estimate
+                .map(|e| format!("{e:e}"))
+                .unwrap_or_default(),
+        );
+        let _ = w.write_record(&row);
     }
-    s
+    String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
 }
 
 /// The frequency-response plot of `max|q_dof|`: stable parts solid, unstable parts dashed,

@@ -56,7 +56,7 @@ pub struct MeshOutput {
     pub force_max: f64,
     /// Largest deviation from the mean, `max |f - f̄|`: the dynamic mesh force.
     pub dynamic_force: f64,
-    /// Dynamic factor `K_v = f_max / f̄` (1 for a steady load; NaN-free: 0 when unloaded).
+    /// Dynamic factor `K_v = max|f| / |f̄|` (1 for a steady load; 0 when unloaded).
     pub dynamic_factor: f64,
 }
 
@@ -195,7 +195,12 @@ pub fn element_outputs(model: &Model, sol: &Solution) -> Result<Vec<ElementOutpu
                 force_mean: mean,
                 force_max: force.max,
                 dynamic_force: (force.max - mean).max(mean - force.min),
-                dynamic_factor: if mean > 0.0 { force.max / mean } else { 0.0 },
+                // Loaded on either flank: the largest |f| over the mean |f̄|.
+                dynamic_factor: if mean != 0.0 {
+                    force.max.abs().max(force.min.abs()) / mean.abs()
+                } else {
+                    0.0
+                },
             }
         });
         out.push(ElementOutput {

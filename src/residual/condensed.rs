@@ -85,15 +85,28 @@ impl HarmonicBalance<'_> {
         }
     }
 
-    /// The unknowns of full harmonics `q` (`(H+1) n`): `q` itself, or `U = Wᵀ Q` when
-    /// condensed; `None` if `q` has neither length.
+    /// The unknowns of `q`, either unknowns already (`(H+1)` times the unknowns per harmonic:
+    /// taken as they are) or full harmonics (`(H+1) n`: `U = Wᵀ Q` when condensed); `None` if
+    /// `q` has neither length. With as many element coordinates as DOFs the two lengths agree
+    /// and `q` is taken as unknowns: pass full harmonics to
+    /// [`unknowns_of_full`](Self::unknowns_of_full).
     pub fn unknowns_of(&self, q: &[Complex64]) -> Option<Vec<Complex64>> {
+        if q.len() == self.len() {
+            return Some(q.to_vec());
+        }
+        self.unknowns_of_full(q)
+    }
+
+    /// The unknowns of the full harmonics `q` (`(H+1) n`, all DOFs): `q` itself, or
+    /// `U = Wᵀ Q` when condensed; `None` if `q` has another length.
+    pub fn unknowns_of_full(&self, q: &[Complex64]) -> Option<Vec<Complex64>> {
         let n = self.model.n_dofs();
+        if q.len() != (self.basis.harmonics() + 1) * n {
+            return None;
+        }
         match &self.condensed {
-            // Full harmonics first: with as many elements as DOFs both have one length.
-            Some(b) if q.len() == (self.basis.harmonics() + 1) * n => Some(b.0.project(q)),
-            _ if q.len() == self.len() => Some(q.to_vec()),
-            _ => None,
+            Some(b) => Some(b.0.project(q)),
+            None => Some(q.to_vec()),
         }
     }
 }

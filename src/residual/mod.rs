@@ -262,24 +262,20 @@ impl<'m> HarmonicBalance<'m> {
         };
         let mean_load: Vec<f64> = hb.f_ext[..n].iter().map(|v| v.re).collect();
         match formulation.resolve(model) {
-            Formulation::Full | Formulation::Auto => {
-                let dense = model.dense("full formulation")?;
-                hb.z = match DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0) {
-                    Err(e @ Error::SingularDynamicStiffness { harmonic: 0, .. }) => {
-                        let Some(rigid) = crate::model::rigid::find_dense(model, &dense) else {
-                            return Err(e);
-                        };
-                        rigid.check_balance(model, &mean_load)?;
-                        let z = free_dynamic_stiffness(&basis, &dense, &rigid)?;
-                        hb.rigid = Some(std::sync::Arc::new(rigid));
-                        z
-                    }
-                    z => z?,
-                };
-                hb.dense = Some(Box::new(dense));
-            }
+            Formulation::Full | Formulation::Auto => hb.factor_full(&mean_load)?,
             Formulation::Condensed => {
-                hb.condense()?;
+                match hb.condense() {
+                    // `auto` falls back to the full formulation where the coordinates are
+                    // linearly dependent (a split power path closes a loop of meshes).
+                    Err(Error::Solver { reason })
+                        if formulation == Formulation::Auto
+                            && n <= Model::MAX_DENSE_DOFS
+                            && reason.contains("linearly dependent") =>
+                    {
+                        return Self::with_formulation(model, basis, Formulation::Full);
+                    }
+                    r => r?,
+                }
                 hb.rigid = hb
                     .condensed
                     .as_ref()
@@ -575,6 +571,27 @@ impl<'m> HarmonicBalance<'m> {
         Ok(())
     }
 
+    /// Builds and factors the dense `Z_k` of the full formulation (with the static
+    /// augmentation of a free-free model, whose mean loads must balance).
+    fn factor_full(&mut self, mean_load: &[f64]) -> Result<()> {
+        let (model, basis) = (self.model, self.basis);
+        let dense = model.dense("full formulation")?;
+        self.z = match DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0) {
+            Err(e @ Error::SingularDynamicStiffness { harmonic: 0, .. }) => {
+                let Some(rigid) = crate::model::rigid::find_dense(model, &dense) else {
+                    return Err(e);
+                };
+                rigid.check_balance(model, mean_load)?;
+                let z = free_dynamic_stiffness(&basis, &dense, &rigid)?;
+                self.rigid = Some(std::sync::Arc::new(rigid));
+                z
+            }
+            z => z?,
+        };
+        self.dense = Some(Box::new(dense));
+        Ok(())
+    }
+
     /// Multiplies the alternating load (harmonics `k >= 1` of `F_ext`) by `factor`; the static
     /// load stays. For a homotopy in the load amplitude.
     pub fn scale_alternating_load(&mut self, factor: f64) {
@@ -584,6 +601,13 @@ impl<'m> HarmonicBalance<'m> {
             .chain(self.f_split[n..].iter_mut())
         {
             *v *= factor;
+        }
+        // The condensed formulation recovers all DOFs from the full load: scale it alike.
+        let n_full = self.model.n_dofs();
+        if let Some(b) = self.condensed.as_mut() {
+            for v in b.1[n_full..].iter_mut() {
+                *v *= factor;
+            }
         }
     }
 

@@ -34,14 +34,14 @@ pub(super) fn add(
         };
         if e.get("type").and_then(Value::as_str) == Some("gear_stage") {
             e.remove("type");
-            let stage = super::gear_stage::read(e, &name, dofs, |f| {
+            let stage = super::gear_stage::read(e, &name, dofs, fundamental_order, |f| {
                 if f.is_empty() {
                     format!("elements[{i}]")
                 } else {
                     at(f)
                 }
             })?;
-            builder = builder.gear_stage(&name, stage.with_fundamental_order(fundamental_order));
+            builder = builder.gear_stage(&name, stage);
             continue;
         }
         let connects: BTreeMap<String, f64> = match e.remove("connects") {

@@ -153,7 +153,11 @@ pub fn write_scene(model: &Model, settings: &SceneSettings, path: &Path) -> Resu
             let mut element = Map::new();
             element.insert("name".into(), json!(e.name()));
             element.insert("type".into(), json!("gear_stage"));
-            let mut fields = serde_json::to_value(stage).map_err(|x| SceneError {
+            // The scene re-reads `shaft_order` against its own fundamental order: keep the mesh
+            // cycles per period.
+            let mut stage = stage.clone();
+            stage.shaft_order *= settings.order / stage.fundamental_order;
+            let mut fields = serde_json::to_value(&stage).map_err(|x| SceneError {
                 file: file.clone(),
                 position: None,
                 path: Some(format!("element `{}`", e.name())),

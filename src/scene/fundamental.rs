@@ -32,6 +32,8 @@ pub(super) struct Speed {
     pub(super) order: f64,
     /// Ω, rad/s.
     pub(super) omega: f64,
+    /// `true` if the order was chosen from the engine and mesh orders.
+    pub(super) chosen: bool,
 }
 
 impl Fundamental {
@@ -60,6 +62,8 @@ impl Fundamental {
             (Some(o), _) => o,
             (None, None) => 1.0,
             (None, Some(e)) => {
+                // A valid table first: the orders below must be finite and positive.
+                e.validate("engine").map_err(super::loads::engine_error)?;
                 let mesh_orders = elements.iter().filter_map(stage_mesh_order);
                 let orders = e.orders.iter().map(|o| o.order);
                 common_divisor(orders.chain(mesh_orders).chain([1.0])).ok_or_else(|| {
@@ -90,6 +94,7 @@ impl Fundamental {
             per_unit,
             order,
             omega,
+            chosen: self.order.is_none() && engine.is_some(),
         })
     }
 }

@@ -11,6 +11,7 @@ pub(super) fn read(
     fields: Map<String, Value>,
     name: &str,
     dofs: &super::dofs::Dofs,
+    fundamental_order: f64,
     at: impl Fn(&str) -> String,
 ) -> Result<GearStage, (String, String)> {
     if fields.contains_key("connects") {
@@ -34,6 +35,7 @@ pub(super) fn read(
             ));
         }
     }
+    let stage = stage.with_fundamental_order(fundamental_order);
     stage
         .validate(&format!("gear stage `{name}`"))
         .map_err(|e| match &e {

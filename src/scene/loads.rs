@@ -10,7 +10,7 @@ use std::collections::HashSet;
 #[serde(deny_unknown_fields)]
 pub(super) struct LoadSpec {
     dof: String,
-    order: usize,
+    pub(super) order: usize,
     #[serde(default)]
     cos: f64,
     #[serde(default)]
@@ -20,6 +20,16 @@ pub(super) struct LoadSpec {
 /// A field path and a message.
 fn fail(path: &str, message: String) -> (String, String) {
     (path.to_string(), message)
+}
+
+/// An engine-table error located at its field (`engine.orders[1].order`).
+pub(super) fn engine_error(e: crate::Error) -> (String, String) {
+    match &e {
+        crate::Error::InvalidParameter { name, .. } => {
+            fail(&format!("engine.{name}"), e.to_string())
+        }
+        _ => fail("engine", e.to_string()),
+    }
 }
 
 /// Adds the loads and the engine's loads (under a fundamental of order `fundamental_order`).
@@ -32,13 +42,7 @@ pub(super) fn add(
     fundamental_order: f64,
 ) -> Result<ModelBuilder, (String, String)> {
     if let Some(engine) = engine {
-        let engine_err = |e: crate::Error| match &e {
-            crate::Error::InvalidParameter { name, .. } => {
-                fail(&format!("engine.{name}"), e.to_string())
-            }
-            _ => fail("engine", e.to_string()),
-        };
-        engine.validate("engine").map_err(engine_err)?;
+        engine.validate("engine").map_err(engine_error)?;
         for (i, dof) in engine.cylinder_dofs().iter().enumerate() {
             if !known.contains(dof.as_str()) {
                 let path = match engine.cylinders {
@@ -49,7 +53,7 @@ pub(super) fn add(
                 return Err((path, message));
             }
         }
-        let loads = engine.loads(fundamental_order).map_err(engine_err)?;
+        let loads = engine.loads(fundamental_order).map_err(engine_error)?;
         for (dof, k, c, s) in loads {
             builder = builder.load(&dof, k, c, s);
         }

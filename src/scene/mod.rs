@@ -127,6 +127,9 @@ pub struct Scene {
     /// The fundamental's order relative to the scene's speed (`fundamental.order`, or chosen
     /// from the engine and mesh orders: 0.5 with half orders).
     pub fundamental_order: f64,
+    /// Things the user should know that are not errors (a `loads` order that counts half
+    /// orders because the engine table chose the fundamental).
+    pub notes: Vec<String>,
     solver: SolverSpec,
 }
 
@@ -243,6 +246,16 @@ impl SceneFile {
             err(&path, message)
         })?;
 
+        let mut notes = Vec::new();
+        if speed.chosen && speed.order != 1.0 && self.loads.iter().any(|l| l.order > 0) {
+            notes.push(format!(
+                "the engine's orders make the fundamental {} of the {} speed: `loads` orders \
+                 count harmonics of it (order 2 there is shaft order {})",
+                speed.order,
+                speed.unit,
+                2.0 * speed.order
+            ));
+        }
         let (basis, auto) = self
             .harmonics
             .basis(speed.omega)
@@ -261,6 +274,7 @@ impl SceneFile {
             speed_unit: speed.unit,
             omega_per_speed: speed.per_unit * speed.order,
             fundamental_order: speed.order,
+            notes,
             solver: self.solver,
         })
     }

@@ -83,8 +83,10 @@ impl CoarseBlock {
                 let mut q = vec![Complex64::default(); hb.len()];
                 layout.unpack(&x, &mut q);
                 let sol = Newton::new().solve_from(&hb, &q, &mut ws)?;
-                if sol.is_converged() {
-                    layout.pack(sol.harmonics(), &mut x);
+                // The solution holds every DOF; the unknowns may be the element coordinates.
+                if let (true, Some(u)) = (sol.is_converged(), hb.unknowns_of_full(sol.harmonics()))
+                {
+                    layout.pack(&u, &mut x);
                 }
             }
             hb.residual_real_into(&x, &mut r, Some(&mut jac), &mut ws)?;
