@@ -103,6 +103,31 @@ enum Command {
         #[arg(long, default_value_t = 101)]
         points: usize,
     },
+    /// Natural frequencies and mode shapes about the scene's periodic solution (with the
+    /// one- and two-tooth bounds of mesh stiffnesses), critical speeds; Campbell diagram.
+    ///
+    /// --from and --to are in the scene's speed unit (default 0 to twice the scene's speed).
+    Modes {
+        /// Scene file (.toml or .json).
+        scene: PathBuf,
+        /// Lowest speed of the Campbell diagram.
+        #[arg(long, allow_negative_numbers = true)]
+        from: Option<f64>,
+        /// Highest speed of the Campbell diagram.
+        #[arg(long, allow_negative_numbers = true)]
+        to: Option<f64>,
+        /// Modes up to this frequency in Hz (default: every mode up to 300 DOFs, else 5000).
+        #[arg(long)]
+        max_hz: Option<f64>,
+        #[command(flatten)]
+        solver: cli::SolverArgs,
+        /// Print exactly one JSON object on stdout instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Write modes.csv and campbell.svg into this directory.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Validate a scene without solving.
     Check {
         /// Scene file (.toml or .json).
@@ -141,6 +166,25 @@ fn main() -> ExitCode {
             out,
         } => cli::compare::compare(&scene, &solver, json, out.as_deref()),
         Command::Check { scene } => cli::check::check(&scene),
+        Command::Modes {
+            scene,
+            from,
+            to,
+            max_hz,
+            solver,
+            json,
+            out,
+        } => cli::modes::modes(
+            &scene,
+            &solver,
+            cli::modes::ModesOptions {
+                from,
+                to,
+                max_hz,
+                json,
+                out: out.as_deref(),
+            },
+        ),
         Command::Sweep {
             scene,
             from,

@@ -25,6 +25,7 @@ macro_rules! say {
 pub(crate) mod check;
 pub(crate) mod compare;
 pub(crate) mod element_report;
+pub(crate) mod modes;
 pub(crate) mod parameter_sweep;
 pub(crate) mod solve;
 pub(crate) mod start;

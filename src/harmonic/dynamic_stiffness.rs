@@ -60,8 +60,9 @@ impl DynamicStiffness {
             if relative_pivot.is_nan() || relative_pivot <= SINGULAR_PIVOT {
                 let hint = if k == 0 {
                     "K0 is singular, but not by a free rigid-body mode (free-free models are \
-                     handled): a motion held only by an element without linear stiffness, or a \
-                     massless DOF; ground it with a stiffness or fix the DOF"
+                     handled): a motion held only by damping to ground or by an element \
+                     without linear stiffness, or a massless DOF; ground it with a stiffness \
+                     or fix the DOF"
                         .to_string()
                 } else {
                     format!(

@@ -2,10 +2,12 @@
 
 mod branch;
 mod element_output;
+mod modes;
 mod plot;
 mod timing;
 
 pub use branch::{branch_csv, branch_plot, branches_plot};
 pub use element_output::{element_outputs, ElementOutput, MeshOutput, Signal};
+pub use modes::{natural_frequencies, NaturalFrequencies};
 pub use plot::{line_plot, Axis, Series};
 pub use timing::median_time;

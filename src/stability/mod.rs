@@ -57,6 +57,7 @@ mod dispatch;
 mod dopri;
 mod flow;
 mod modes;
+pub(crate) use modes::lowest_modes;
 mod neutral;
 mod reduction;
 mod shooting;
