@@ -205,3 +205,52 @@ fn cli_writes_element_outputs() {
         .all(|r| r.len() == 6 && &r[0] == "mesh, stage 1"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Files of a solve that did not converge carry the status in their names and plot titles;
+/// the plot titles name the scene and the speed.
+#[test]
+fn unconverged_outputs_say_so() {
+    let dir = std::env::temp_dir().join(format!("hbal-unconverged-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/gear_backlash.toml"),
+    )
+    .unwrap()
+    .replace("rad_s = 0.7", "rad_s = 1.0")
+        + "\n[solver]\nmethod = \"fixed_point\"\nmax_iterations = 2\n";
+    let text = text.replacen("[solver]\nmethod = \"newton\"\n", "", 1);
+    let scene = dir.join("stuck.toml");
+    std::fs::write(&scene, text).unwrap();
+    let run = |out: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+            .args(["solve", scene.to_str().unwrap(), "--no-stability", "--out"])
+            .arg(dir.join(out))
+            .output()
+            .unwrap()
+    };
+    let out = run("stuck");
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "harmonics.csv",
+        "elements.csv",
+        "time_series.csv",
+        "time_series.svg",
+    ] {
+        assert!(
+            dir.join("stuck")
+                .join(format!("not_converged_{f}"))
+                .exists(),
+            "{f}"
+        );
+        assert!(!dir.join("stuck").join(f).exists(), "{f}");
+    }
+    let svg = std::fs::read_to_string(dir.join("stuck/not_converged_time_series.svg")).unwrap();
+    assert!(svg.contains("NOT CONVERGED"), "title");
+    assert!(svg.contains("at 1 rad_s"), "speed in the title");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -198,3 +198,18 @@ pub(crate) fn modulus(x: f64) -> String {
         format!("{x:.3e}")
     }
 }
+
+/// A speed for titles: up to 6 significant digits, no trailing zeros (`2000`, `1.3455`).
+pub(crate) fn speed_text(v: f64) -> String {
+    let digits = if v == 0.0 || !v.is_finite() {
+        0
+    } else {
+        (5 - v.abs().log10().floor() as i32).clamp(0, 12) as usize
+    };
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}

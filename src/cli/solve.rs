@@ -270,14 +270,34 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         _ => {}
     }
     if let Some(dir) = out {
-        write_outputs(dir, &sol)?;
+        // Files of an unconverged iterate say so in their names and plot titles.
+        let prefix = if sol.is_converged() {
+            ""
+        } else {
+            "not_converged_"
+        };
+        let label = OutputLabel {
+            title: format!(
+                "{} at {} {}{}",
+                scene.file,
+                super::speed_text(sol.basis().omega() / scene.omega_per_speed),
+                scene.speed_unit,
+                if sol.is_converged() {
+                    String::new()
+                } else {
+                    format!(" - NOT CONVERGED ({})", sol.termination)
+                }
+            ),
+            prefix,
+        };
+        write_outputs(dir, &sol, &label)?;
         if let Ok(e) = &elements {
-            element_report::write_csv(&dir.join("elements.csv"), e, order)
+            element_report::write_csv(&dir.join(format!("{prefix}elements.csv")), e, order)
                 .with_context(|| format!("--out: cannot write {}", dir.display()))?;
         }
         if !as_json {
             say!(
-                "  wrote harmonics.csv, elements.csv, time_series.csv, time_series.svg, spectrum.svg to {}",
+                "  wrote {prefix}harmonics.csv, {prefix}elements.csv, {prefix}time_series.csv, {prefix}time_series.svg, {prefix}spectrum.svg to {}",
                 dir.display()
             );
         }
@@ -300,11 +320,18 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     })
 }
 
-fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
+/// The plots' title (scene, speed, status) and the file-name prefix of an unconverged solve.
+struct OutputLabel {
+    title: String,
+    prefix: &'static str,
+}
+
+fn write_outputs(dir: &Path, sol: &Solution, label: &OutputLabel) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let file = |name: &str| dir.join(format!("{}{name}", label.prefix));
     let h = sol.basis().harmonics();
     // CSV through the csv writer: a DOF name with a comma or a quote is quoted.
-    let mut w = csv::Writer::from_path(dir.join("harmonics.csv"))?;
+    let mut w = csv::Writer::from_path(file("harmonics.csv"))?;
     w.write_record(["dof", "order", "cos", "sin"])?;
     for (i, name) in sol.dof_names().iter().enumerate() {
         for k in 0..=h {
@@ -323,7 +350,7 @@ fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
     let series: Vec<Vec<f64>> = (0..sol.dof_names().len())
         .map(|i| sol.time_series(i, points))
         .collect();
-    let mut w = csv::Writer::from_path(dir.join("time_series.csv"))?;
+    let mut w = csv::Writer::from_path(file("time_series.csv"))?;
     let mut header = vec!["t".to_string(), "theta".to_string()];
     header.extend(sol.dof_names().iter().cloned());
     w.write_record(&header)?;
@@ -353,10 +380,10 @@ fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
         })
         .collect();
     line_plot(
-        &dir.join("time_series.svg"),
-        &format!("Periodic solution over one period{note}"),
+        &file("time_series.svg"),
+        &format!("{}: one period{note}", label.title),
         &Axis::linear("t (s)"),
-        &Axis::linear("q"),
+        &Axis::linear("q (rad or m)"),
         &lines,
     )
     .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
@@ -374,10 +401,13 @@ fn write_outputs(dir: &Path, sol: &Solution) -> anyhow::Result<()> {
         .collect();
     if h > 0 {
         line_plot(
-            &dir.join("spectrum.svg"),
-            &format!("Amplitude spectrum (static part omitted){note}"),
-            &Axis::linear("harmonic order"),
-            &Axis::log("amplitude"),
+            &file("spectrum.svg"),
+            &format!(
+                "{}: amplitude spectrum (static part omitted){note}",
+                label.title
+            ),
+            &Axis::linear("harmonic k"),
+            &Axis::log("|q_k| (rad or m)"),
             &spectra,
         )
         .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
