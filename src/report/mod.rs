@@ -9,5 +9,5 @@ mod timing;
 pub use branch::{branch_csv, branch_plot, branches_plot};
 pub use element_output::{element_outputs, ElementOutput, MeshOutput, Signal};
 pub use modes::{natural_frequencies, NaturalFrequencies};
-pub use plot::{line_plot, Axis, Series};
+pub use plot::{line_plot, tick_label, Axis, Series};
 pub use timing::median_time;

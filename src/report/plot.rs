@@ -147,20 +147,14 @@ pub fn line_plot(
     macro_rules! draw {
         ($chart:expr) => {{
             let mut chart = $chart;
-            let fmt = |v: &f64| {
-                let a = v.abs();
-                if a != 0.0 && !(1e-3..1e4).contains(&a) {
-                    format!("{v:.0e}")
-                } else {
-                    format!("{}", (v * 1e6).round() / 1e6)
-                }
-            };
+            let fmt_x = |v: &f64| tick_label(*v, x0, x1);
+            let fmt_y = |v: &f64| tick_label(*v, y0, y1);
             chart
                 .configure_mesh()
                 .x_desc(x.label.as_str())
                 .y_desc(y.label.as_str())
-                .x_label_formatter(&fmt)
-                .y_label_formatter(&fmt)
+                .x_label_formatter(&fmt_x)
+                .y_label_formatter(&fmt_y)
                 .draw()?;
             for (i, (s, p)) in series.iter().zip(&pts).enumerate() {
                 let color = COLORS[s.color.unwrap_or(i) % COLORS.len()];
@@ -217,4 +211,45 @@ pub fn line_plot(
     }
     root.present()?;
     Ok(())
+}
+
+/// A tick label on an axis from `lo` to `hi`: rounding noise next to zero is `0`, and enough
+/// digits that neighbouring ticks (about a tenth of the range apart) differ; scientific
+/// notation outside `[1e-3, 1e4)`.
+///
+/// ```
+/// use hbal::report::tick_label;
+/// assert_eq!(tick_label(3e-18, -1.0, 1.0), "0");
+/// assert_ne!(tick_label(2.1e-4, 2.0e-4, 2.5e-4), tick_label(2.2e-4, 2.0e-4, 2.5e-4));
+/// assert_eq!(tick_label(1500.0, 800.0, 6000.0), "1500");
+/// assert_eq!(tick_label(0.25, 0.0, 1.0), "0.25");
+/// ```
+pub fn tick_label(v: f64, lo: f64, hi: f64) -> String {
+    let magnitude = lo.abs().max(hi.abs());
+    let step = ((hi - lo).abs() / 10.0).max(f64::MIN_POSITIVE);
+    if !v.is_finite() {
+        return String::new();
+    }
+    if v.abs() <= 1e-9 * magnitude.max(step) {
+        return "0".into();
+    }
+    // One digit more than the step needs (plotters puts ticks at 1, 2 or 5 times a decade).
+    let trim = |s: &str| {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s.to_string()
+        }
+    };
+    if magnitude >= 1e4 || magnitude < 1e-3 {
+        let digits = 1 + (magnitude / step).log10().ceil().clamp(0.0, 6.0) as usize;
+        let s = format!("{v:.digits$e}");
+        match s.split_once('e') {
+            Some((mantissa, exponent)) => format!("{}e{exponent}", trim(mantissa)),
+            None => s,
+        }
+    } else {
+        let decimals = 1 + (-step.log10()).ceil().clamp(0.0, 8.0) as usize;
+        trim(&format!("{v:.decimals$}"))
+    }
 }
