@@ -241,7 +241,7 @@ pub fn tick_label(v: f64, lo: f64, hi: f64) -> String {
             s.to_string()
         }
     };
-    if magnitude >= 1e4 || magnitude < 1e-3 {
+    if !(1e-3..1e4).contains(&magnitude) {
         let digits = 1 + (magnitude / step).log10().ceil().clamp(0.0, 6.0) as usize;
         let s = format!("{v:.digits$e}");
         match s.split_once('e') {
