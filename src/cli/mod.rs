@@ -26,6 +26,7 @@ pub(crate) mod check;
 pub(crate) mod compare;
 pub(crate) mod element_report;
 pub(crate) mod modes;
+pub(crate) mod order_cuts;
 pub(crate) mod parameter_sweep;
 pub(crate) mod solve;
 pub(crate) mod start;

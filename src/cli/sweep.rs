@@ -327,6 +327,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             dir.join("branch.csv"),
             hbal::report::branch_csv(&branch, unit, speed),
         )?;
+        super::order_cuts::write(dir, &scene, &branch, &basis, speed)?;
         for (i, b) in secondary.iter().enumerate() {
             std::fs::write(
                 dir.join(format!("branch_{}.csv", i + 1)),

@@ -147,8 +147,8 @@ pub fn line_plot(
     macro_rules! draw {
         ($chart:expr) => {{
             let mut chart = $chart;
-            let fmt_x = |v: &f64| tick_label(*v, x0, x1);
-            let fmt_y = |v: &f64| tick_label(*v, y0, y1);
+            let fmt_x = |v: &f64| axis_tick_label(*v, x0, x1, x.log);
+            let fmt_y = |v: &f64| axis_tick_label(*v, y0, y1, y.log);
             chart
                 .configure_mesh()
                 .x_desc(x.label.as_str())
@@ -252,4 +252,14 @@ pub fn tick_label(v: f64, lo: f64, hi: f64) -> String {
         let decimals = 1 + (-step.log10()).ceil().clamp(0.0, 8.0) as usize;
         trim(&format!("{v:.decimals$}"))
     }
+}
+
+/// [`tick_label`], or on a logarithmic axis (ticks a decade or a factor apart) three
+/// significant digits of the value itself.
+fn axis_tick_label(v: f64, lo: f64, hi: f64, log: bool) -> String {
+    if !log {
+        return tick_label(v, lo, hi);
+    }
+    let magnitude = v.abs().max(f64::MIN_POSITIVE);
+    tick_label(v, v - 0.001 * magnitude, v + 0.001 * magnitude)
 }

@@ -1,0 +1,160 @@
+//! Order cuts of a speed sweep: for every point of the branch, the amplitude and phase of each
+//! excitation order (the scene's load orders and mesh orders, as multiples of the reference
+//! speed) of every DOF (up to 50 DOFs) and every element coordinate, and the fraction of the period each
+//! contact spends open: `order_cuts.csv`, and `order_cuts.svg` for the first gear stage's
+//! transmission error (else the DOF that moves most).
+
+use hbal::continuation::Branch;
+use hbal::report::{element_outputs, line_plot, Axis, Series};
+use hbal::scene::Scene;
+use hbal::{HarmonicBasis, Solution};
+use std::path::Path;
+
+/// Most DOFs with columns of their own in `order_cuts.csv`.
+const MAX_DOF_COLUMNS: usize = 50;
+
+/// The excitation orders (multiples of the reference speed) and their harmonic index on
+/// `basis`, where they are harmonics of it.
+pub(crate) fn orders(scene: &Scene, basis: &HarmonicBasis) -> Vec<(f64, usize)> {
+    let f = scene.fundamental_order / basis.subharmonic() as f64;
+    let mut ks: Vec<usize> = scene
+        .model
+        .loads()
+        .iter()
+        .filter(|l| l.order > 0)
+        .map(|l| l.order * basis.subharmonic())
+        .chain(
+            scene
+                .model
+                .elements()
+                .iter()
+                .filter_map(|e| e.law().time_order())
+                .map(|z| z * basis.subharmonic()),
+        )
+        .filter(|&k| k <= basis.harmonics())
+        .collect();
+    ks.sort_unstable();
+    ks.dedup();
+    ks.into_iter().map(|k| (k as f64 * f, k)).collect()
+}
+
+/// Writes `order_cuts.csv` and `order_cuts.svg` for `branch` (computed on `basis`) into `dir`.
+pub(crate) fn write(
+    dir: &Path,
+    scene: &Scene,
+    branch: &Branch,
+    basis: &HarmonicBasis,
+    speed: impl Fn(f64) -> f64,
+) -> anyhow::Result<()> {
+    let orders = orders(scene, basis);
+    let n = branch.dofs.len();
+    let mut w = csv::Writer::from_path(dir.join("order_cuts.csv"))?;
+    let mut header = vec![scene.speed_unit.to_string()];
+    // Every DOF of a model of at most MAX_DOF_COLUMNS DOFs (a large model: its elements only).
+    let dof_columns = if n <= MAX_DOF_COLUMNS { n } else { 0 };
+    let names: Vec<String> = branch.dofs[..dof_columns]
+        .iter()
+        .cloned()
+        .chain(
+            scene
+                .model
+                .elements()
+                .iter()
+                .map(|e| format!("u({})", e.name())),
+        )
+        .collect();
+    for name in &names {
+        for (o, _) in &orders {
+            header.push(format!("amp_{name}_order_{o}"));
+            header.push(format!("phase_deg_{name}_order_{o}"));
+        }
+    }
+    let contacts: Vec<usize> = (0..scene.model.elements().len())
+        .filter(|&i| !scene.model.elements()[i].law().kinks().is_empty())
+        .collect();
+    for &i in &contacts {
+        header.push(format!("open_{}", scene.model.elements()[i].name()));
+    }
+    w.write_record(&header)?;
+    // The plotted output: the first gear stage's TE in µm, else the DOF that moves most.
+    let stage = scene
+        .model
+        .elements()
+        .iter()
+        .position(|e| e.gear_stage().is_some());
+    let mut curves: Vec<Vec<(f64, f64)>> = vec![Vec::new(); orders.len()];
+    for p in &branch.points {
+        let sol = Solution::from_harmonics(
+            basis.with_omega(p.omega)?,
+            branch.dofs.clone(),
+            p.harmonics.clone(),
+            p.residual,
+        )?;
+        let outputs = element_outputs(&scene.model, &sol)?;
+        let mut row = vec![format!("{:e}", speed(p.omega))];
+        let harmonic_of = |name: usize, k: usize| {
+            if name < dof_columns {
+                p.harmonics[k * n + name]
+            } else {
+                outputs[name - dof_columns].coordinate.harmonics[k]
+            }
+        };
+        for name in 0..names.len() {
+            for &(_, k) in &orders {
+                let x = harmonic_of(name, k);
+                row.push(format!("{:e}", x.norm()));
+                // q = Re(Q e^{ikθ}) = |Q| cos(kθ + arg Q).
+                row.push(format!("{:e}", x.arg().to_degrees()));
+            }
+        }
+        for &i in &contacts {
+            let open = outputs[i]
+                .states
+                .iter()
+                .find(|(s, _)| s == "open")
+                .map_or(f64::NAN, |(_, f)| *f);
+            row.push(if open.is_nan() {
+                String::new()
+            } else {
+                format!("{open:e}")
+            });
+        }
+        w.write_record(&row)?;
+        for (c, &(_, k)) in curves.iter_mut().zip(&orders) {
+            let a = match stage {
+                Some(s) => 1e6 * outputs[s].coordinate.harmonics[k].norm(),
+                None => {
+                    let top = (0..n)
+                        .max_by(|&a, &b| p.max_abs[a].total_cmp(&p.max_abs[b]))
+                        .unwrap_or(0);
+                    p.harmonics[k * n + top].norm()
+                }
+            };
+            c.push((speed(p.omega), a));
+        }
+    }
+    w.flush()?;
+    let (what, unit) = match stage {
+        Some(s) => (
+            format!("transmission error of {}", scene.model.elements()[s].name()),
+            "µm",
+        ),
+        None => ("largest response".to_string(), "rad or m"),
+    };
+    let series: Vec<Series> = curves
+        .into_iter()
+        .zip(&orders)
+        .map(|(c, (o, _))| Series::line(format!("order {o}"), c))
+        .collect();
+    if branch.points.len() >= 2 && !series.is_empty() {
+        line_plot(
+            &dir.join("order_cuts.svg"),
+            &format!("Order cuts of the {what}: {}", scene.file),
+            &Axis::linear(format!("speed ({})", scene.speed_unit)),
+            &Axis::log(format!("amplitude ({unit})")),
+            &series,
+        )
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    }
+    Ok(())
+}
