@@ -83,7 +83,7 @@ pub enum Error {
     },
     /// An element's time variation (a mesh order) lies above the number of harmonics: its
     /// response would be missing, or aliased onto lower harmonics.
-    #[error("element `{element}` varies at order {order} (its mesh cycles per period) but only {harmonics} harmonics are kept: raise H to at least {order}, better a few times that")]
+    #[error("element `{element}` varies at order {order} (its mesh cycles per period) but only {harmonics} harmonics are kept: {}", order_advice(*.order))]
     ElementOrderTooHigh {
         /// The element.
         element: String,
@@ -185,5 +185,19 @@ pub(crate) fn check_finite(context: &str, name: &str, value: f64) -> Result<()> 
         Ok(())
     } else {
         Err(Error::invalid(context, name, value, "finite"))
+    }
+}
+
+/// What to do about a time order above H: raise H, or, beyond any basis, check the element.
+fn order_advice(order: usize) -> String {
+    if order <= crate::HarmonicBasis::MAX_HARMONICS / 4 {
+        format!("raise H to at least {order}, better a few times that")
+    } else {
+        format!(
+            "that is more than any harmonic basis holds (H <= {}): check the element's `teeth` \
+             (mesh cycles per period of the fundamental), or make the mesh order the fundamental \
+             (`fundamental.order`)",
+            crate::HarmonicBasis::MAX_HARMONICS
+        )
     }
 }

@@ -303,3 +303,25 @@ fn gear_stage_survives_scene_export() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A mesh order beyond any harmonic basis (4e9 teeth) is refused at once, with advice, and
+/// allocates nothing on the way (it once aborted allocating 64 GB).
+#[test]
+fn absurd_tooth_counts_are_refused_with_advice() {
+    let text = GOOD.replace("teeth = 2", "teeth = 4000000000").replace(
+        "stiffness = { shape = \"constant\", stiffness = 3e8 }",
+        "stiffness = { shape = \"rectangular\", one_tooth = 3e8, two_tooth = 5e8, contact_ratio = 1.5 }",
+    );
+    assert!(text.contains("rectangular"));
+    let dir = std::env::temp_dir().join(format!("hbal-teeth-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("teeth.toml");
+    std::fs::write(&p, text).unwrap();
+    for cmd in ["check", "solve"] {
+        let out = common::hbal(&[cmd, p.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{cmd}: {err}");
+        assert!(err.contains("more than any harmonic basis holds"), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
