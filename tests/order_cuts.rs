@@ -84,3 +84,74 @@ fn order_cuts_equal_the_harmonics_of_the_points() {
     assert!(dir.join("order_cuts.svg").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The backlash gear pair loses contact over part of its sweep: the reported range holds every
+/// point whose orbit enters the backlash (counted on the orbit), and the largest open fraction
+/// matches the count.
+#[test]
+fn sweep_reports_where_the_contact_opens() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/gear_backlash.toml");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args([
+            "sweep",
+            scene.to_str().unwrap(),
+            "--from",
+            "0.4",
+            "--to",
+            "1.6",
+            "--no-stability",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let loss = doc["contact_loss"].as_array().unwrap();
+    assert_eq!(loss.len(), 1, "{loss:?}");
+    let (from, to) = (
+        loss[0]["from"].as_f64().unwrap(),
+        loss[0]["to"].as_f64().unwrap(),
+    );
+    assert_eq!(loss[0]["element"], "contact");
+    let mut largest: f64 = 0.0;
+    for p in doc["points"].as_array().unwrap() {
+        let h: Vec<hbal::num_complex::Complex64> = p["harmonics"][0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                hbal::harmonic::from_cos_sin(c["cos"].as_f64().unwrap(), c["sin"].as_f64().unwrap())
+            })
+            .collect();
+        let samples = 20000;
+        let open = (0..samples)
+            .filter(|j| {
+                let t = std::f64::consts::TAU * *j as f64 / samples as f64;
+                let x: f64 = h
+                    .iter()
+                    .enumerate()
+                    .map(|(k, q)| {
+                        (q * hbal::num_complex::Complex64::from_polar(1.0, k as f64 * t)).re
+                    })
+                    .sum();
+                x.abs() <= 1.0
+            })
+            .count() as f64
+            / samples as f64;
+        let s = p["speed"].as_f64().unwrap();
+        if open > 2e-3 {
+            assert!(
+                s >= from - 1e-12 && s <= to + 1e-12,
+                "open {open} at {s} outside [{from}, {to}]"
+            );
+        }
+        largest = largest.max(open);
+    }
+    let reported = loss[0]["max_open"].as_f64().unwrap();
+    assert!((reported - largest).abs() < 2e-3, "{reported} vs {largest}");
+}

@@ -158,3 +158,73 @@ pub(crate) fn write(
     }
     Ok(())
 }
+
+/// A speed range over which a contact opens for part of the period.
+#[derive(Debug, Clone, serde::Serialize)]
+pub(crate) struct ContactLoss {
+    pub(crate) element: String,
+    pub(crate) from: f64,
+    pub(crate) to: f64,
+    /// The largest fraction of the period it is open.
+    pub(crate) max_open: f64,
+}
+
+/// The ranges of consecutive points of `branch` where an element with an `open` state opens
+/// (more than 0.1 % of the period), in the speed unit of `speed`.
+pub(crate) fn contact_loss(
+    scene: &Scene,
+    branch: &Branch,
+    basis: &HarmonicBasis,
+    speed: impl Fn(f64) -> f64,
+) -> anyhow::Result<Vec<ContactLoss>> {
+    let has_open = |i: usize| {
+        scene.model.elements()[i]
+            .law()
+            .state_names()
+            .contains(&"open")
+    };
+    let contacts: Vec<usize> = (0..scene.model.elements().len())
+        .filter(|&i| has_open(i))
+        .collect();
+    let mut out = Vec::new();
+    if contacts.is_empty() {
+        return Ok(out);
+    }
+    let mut open: Vec<Option<ContactLoss>> = vec![None; contacts.len()];
+    for p in &branch.points {
+        let sol = Solution::from_harmonics(
+            basis.with_omega(p.omega)?,
+            branch.dofs.clone(),
+            p.harmonics.clone(),
+            p.residual,
+        )?;
+        let outputs = element_outputs(&scene.model, &sol)?;
+        let s = speed(p.omega);
+        for (slot, &i) in open.iter_mut().zip(&contacts) {
+            let fraction = outputs[i]
+                .states
+                .iter()
+                .find(|(n, _)| n == "open")
+                .map_or(0.0, |(_, f)| *f);
+            match (slot.as_mut(), fraction > 1e-3) {
+                (Some(run), true) => {
+                    run.from = run.from.min(s);
+                    run.to = run.to.max(s);
+                    run.max_open = run.max_open.max(fraction);
+                }
+                (None, true) => {
+                    *slot = Some(ContactLoss {
+                        element: outputs[i].name.clone(),
+                        from: s,
+                        to: s,
+                        max_open: fraction,
+                    })
+                }
+                (Some(_), false) => out.extend(slot.take()),
+                (None, false) => {}
+            }
+        }
+    }
+    out.extend(open.into_iter().flatten());
+    Ok(out)
+}

@@ -226,6 +226,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         .filter(|p| p.fold)
         .map(|p| speed(p.fold_omega.unwrap_or(p.omega)))
         .collect();
+    // Where contacts open along the branch (backlash, gap contacts).
+    let contact_loss = super::order_cuts::contact_loss(&scene, &branch, &basis, speed)?;
     if as_json {
         let points: Vec<_> = branch
             .points
@@ -249,6 +251,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 "seconds": seconds,
                 "dofs": branch.dofs,
                 "branches": secondary.iter().map(|b| secondary_json(b, speed)).collect::<Vec<_>>(),
+                "contact_loss": contact_loss,
             })
         );
     } else {
@@ -281,6 +284,15 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             say!(
                 "  stability unknown: not available for laws with memory (element `{}`)",
                 e.name()
+            );
+        }
+        for c in &contact_loss {
+            say!(
+                "  contact `{}` opens from {} to {} {unit} (up to {:.1} % of the period)",
+                c.element,
+                super::speed_text(c.from),
+                super::speed_text(c.to),
+                100.0 * c.max_open
             );
         }
         let worst = branch
