@@ -353,7 +353,15 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                     &dir.join(format!("frequency_response_{dof}.svg")),
                     &all,
                     i,
-                    &format!("Frequency response of {dof}"),
+                    &format!(
+                        "Frequency response of {dof}: {}{}",
+                        scene.file,
+                        if branch.stop == BranchStop::Reached {
+                            String::new()
+                        } else {
+                            format!(" - STOPPED: {}", branch.stop)
+                        }
+                    ),
                     &format!("speed ({unit})"),
                     speed,
                 )

@@ -189,7 +189,7 @@ pub fn branches_plot(
         path,
         title,
         &Axis::linear(x_label),
-        &Axis::linear(format!("max |{}|", branches[0].dofs[dof])),
+        &Axis::linear(format!("max |{}| (rad or m)", branches[0].dofs[dof])),
         &series,
     )
 }
