@@ -4,6 +4,9 @@
 //! against finite differences, Newton's iteration counts, the frequency response over NLvib's
 //! range, and points against the time-domain reference (which shows its own convergence).
 
+mod common;
+
+use common::time_domain::state_at_zero;
 use hbal::compare::relative_error;
 use hbal::force::{ForceLaw, Jenkins, Offset};
 use hbal::nalgebra::DMatrix;
@@ -18,22 +21,6 @@ fn scene() -> Scene {
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/nlvib_07_jenkins.toml"),
     )
     .unwrap()
-}
-
-/// The state `(q, q̇)` at θ = 0 of harmonics `x`.
-fn state_at_zero(x: &[Complex64], n: usize, omega: f64) -> (Vec<f64>, Vec<f64>) {
-    let h = x.len() / n - 1;
-    let q = (0..n)
-        .map(|i| (0..=h).map(|k| x[k * n + i].re).sum())
-        .collect();
-    let v = (0..n)
-        .map(|i| {
-            (1..=h)
-                .map(|k| (x[k * n + i] * Complex64::new(0.0, k as f64 * omega)).re)
-                .sum()
-        })
-        .collect();
-    (q, v)
 }
 
 /// Newton (to 1e-12) from the linear start with `h` harmonics and `samples` samples.

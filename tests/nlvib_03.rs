@@ -5,6 +5,9 @@
 //! response is continued from Ω = 0.8 down to 0.5 through both turning points; stable points
 //! are checked against the time-domain reference.
 
+mod common;
+
+use common::time_domain::state_at_zero;
 use hbal::compare::relative_error;
 use hbal::continuation::{BranchPoint, BranchStop, Continuation};
 use hbal::num_complex::Complex64;
@@ -37,22 +40,10 @@ fn refine(model: &Model, p: &BranchPoint, h: usize) -> Vec<Complex64> {
 
 /// The time-domain reference started on the state of `x` at t = 0.
 fn time_domain(model: &Model, omega: f64, x: &[Complex64]) -> Vec<Complex64> {
-    let n = model.n_dofs();
-    let h = x.len() / n - 1;
-    let q = (0..n)
-        .map(|i| (0..=h).map(|k| x[k * n + i].re).sum())
-        .collect();
-    let v = (0..n)
-        .map(|i| {
-            (1..=h)
-                .map(|k| (x[k * n + i] * Complex64::new(0.0, k as f64 * omega)).re)
-                .sum()
-        })
-        .collect();
     let td = TimeSimulation {
         rtol: 1e-12,
         steady_tolerance: 1e-10,
-        initial: Some((q, v)),
+        initial: Some(state_at_zero(x, model.n_dofs(), omega)),
         max_periods: 5000,
         ..TimeSimulation::default()
     }

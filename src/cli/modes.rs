@@ -20,30 +20,6 @@ pub(crate) struct ModesOptions<'a> {
     pub(crate) out: Option<&'a Path>,
 }
 
-/// The excitation orders of the scene relative to its reference speed: its loads and its
-/// time-varying elements (mesh orders), each `k · fundamental.order`.
-fn excitation_orders(scene: &Scene) -> Vec<f64> {
-    let f = scene.fundamental_order / scene.basis.subharmonic() as f64;
-    let mut orders: Vec<f64> = scene
-        .model
-        .loads()
-        .iter()
-        .filter(|l| l.order > 0)
-        .map(|l| l.order as f64 * f)
-        .chain(
-            scene
-                .model
-                .elements()
-                .iter()
-                .filter_map(|e| e.law().time_order())
-                .map(|z| z as f64 * f),
-        )
-        .collect();
-    orders.sort_by(f64::total_cmp);
-    orders.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
-    orders
-}
-
 pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Result<u8, Failure> {
     let scene = load(path, args)?;
     let speed = scene.basis.omega() / scene.omega_per_speed;
@@ -81,7 +57,10 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
         code: super::exit_code(&e),
         error: anyhow::Error::new(e).context(scene.file.clone()),
     })?;
-    let orders = excitation_orders(&scene);
+    let orders: Vec<f64> = super::excitation_orders(&scene, &scene.basis)
+        .into_iter()
+        .map(|(o, _)| o)
+        .collect();
     // rad/s of the reference shaft per unit of speed.
     let per_unit = scene.omega_per_speed / scene.fundamental_order;
     let critical: Vec<(f64, usize, f64)> = orders

@@ -5,7 +5,7 @@
 //! transmission error (else the DOF that moves most).
 
 use hbal::continuation::Branch;
-use hbal::report::{element_outputs, line_plot, Axis, Series};
+use hbal::report::{element_outputs, line_plot, Axis, ElementOutput, Series};
 use hbal::scene::Scene;
 use hbal::{HarmonicBasis, Solution};
 use std::path::Path;
@@ -13,40 +13,16 @@ use std::path::Path;
 /// Most DOFs with columns of their own in `order_cuts.csv`.
 const MAX_DOF_COLUMNS: usize = 50;
 
-/// The excitation orders (multiples of the reference speed) and their harmonic index on
-/// `basis`, where they are harmonics of it.
-pub(crate) fn orders(scene: &Scene, basis: &HarmonicBasis) -> Vec<(f64, usize)> {
-    let f = scene.fundamental_order / basis.subharmonic() as f64;
-    let mut ks: Vec<usize> = scene
-        .model
-        .loads()
-        .iter()
-        .filter(|l| l.order > 0)
-        .map(|l| l.order * basis.subharmonic())
-        .chain(
-            scene
-                .model
-                .elements()
-                .iter()
-                .filter_map(|e| e.law().time_order())
-                .map(|z| z * basis.subharmonic()),
-        )
-        .filter(|&k| k <= basis.harmonics())
-        .collect();
-    ks.sort_unstable();
-    ks.dedup();
-    ks.into_iter().map(|k| (k as f64 * f, k)).collect()
-}
-
 /// Writes `order_cuts.csv` and `order_cuts.svg` for `branch` (computed on `basis`) into `dir`.
 pub(crate) fn write(
     dir: &Path,
     scene: &Scene,
     branch: &Branch,
     basis: &HarmonicBasis,
+    outputs: &[Vec<ElementOutput>],
     speed: impl Fn(f64) -> f64,
 ) -> anyhow::Result<()> {
-    let orders = orders(scene, basis);
+    let orders = super::excitation_orders(scene, basis);
     let n = branch.dofs.len();
     let mut w = csv::Writer::from_path(dir.join("order_cuts.csv"))?;
     let mut header = vec![scene.speed_unit.to_string()];
@@ -83,14 +59,7 @@ pub(crate) fn write(
         .iter()
         .position(|e| e.gear_stage().is_some());
     let mut curves: Vec<Vec<(f64, f64)>> = vec![Vec::new(); orders.len()];
-    for p in &branch.points {
-        let sol = Solution::from_harmonics(
-            basis.with_omega(p.omega)?,
-            branch.dofs.clone(),
-            p.harmonics.clone(),
-            p.residual,
-        )?;
-        let outputs = element_outputs(&scene.model, &sol)?;
+    for (p, outputs) in branch.points.iter().zip(outputs) {
         let mut row = vec![format!("{:e}", speed(p.omega))];
         let harmonic_of = |name: usize, k: usize| {
             if name < dof_columns {
@@ -174,9 +143,9 @@ pub(crate) struct ContactLoss {
 pub(crate) fn contact_loss(
     scene: &Scene,
     branch: &Branch,
-    basis: &HarmonicBasis,
+    outputs: &[Vec<ElementOutput>],
     speed: impl Fn(f64) -> f64,
-) -> anyhow::Result<Vec<ContactLoss>> {
+) -> Vec<ContactLoss> {
     let has_open = |i: usize| {
         scene.model.elements()[i]
             .law()
@@ -188,17 +157,10 @@ pub(crate) fn contact_loss(
         .collect();
     let mut out = Vec::new();
     if contacts.is_empty() {
-        return Ok(out);
+        return out;
     }
     let mut open: Vec<Option<ContactLoss>> = vec![None; contacts.len()];
-    for p in &branch.points {
-        let sol = Solution::from_harmonics(
-            basis.with_omega(p.omega)?,
-            branch.dofs.clone(),
-            p.harmonics.clone(),
-            p.residual,
-        )?;
-        let outputs = element_outputs(&scene.model, &sol)?;
+    for (p, outputs) in branch.points.iter().zip(outputs) {
         let s = speed(p.omega);
         for (slot, &i) in open.iter_mut().zip(&contacts) {
             let fraction = outputs[i]
@@ -226,5 +188,27 @@ pub(crate) fn contact_loss(
         }
     }
     out.extend(open.into_iter().flatten());
-    Ok(out)
+    out
+}
+
+/// The element outputs of every point of `branch` (computed on `basis`), for the order cuts
+/// and the contact-loss ranges.
+pub(crate) fn point_outputs(
+    scene: &Scene,
+    branch: &Branch,
+    basis: &HarmonicBasis,
+) -> anyhow::Result<Vec<Vec<ElementOutput>>> {
+    branch
+        .points
+        .iter()
+        .map(|p| {
+            let sol = Solution::from_harmonics(
+                basis.with_omega(p.omega)?,
+                branch.dofs.clone(),
+                p.harmonics.clone(),
+                p.residual,
+            )?;
+            Ok(element_outputs(&scene.model, &sol)?)
+        })
+        .collect()
 }

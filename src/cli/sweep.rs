@@ -227,7 +227,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         .map(|p| speed(p.fold_omega.unwrap_or(p.omega)))
         .collect();
     // Where contacts open along the branch (backlash, gap contacts).
-    let contact_loss = super::order_cuts::contact_loss(&scene, &branch, &basis, speed)?;
+    let outputs = super::order_cuts::point_outputs(&scene, &branch, &basis)?;
+    let contact_loss = super::order_cuts::contact_loss(&scene, &branch, &outputs, speed);
     if as_json {
         let points: Vec<_> = branch
             .points
@@ -339,7 +340,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             dir.join("branch.csv"),
             hbal::report::branch_csv(&branch, unit, speed),
         )?;
-        super::order_cuts::write(dir, &scene, &branch, &basis, speed)?;
+        super::order_cuts::write(dir, &scene, &branch, &basis, &outputs, speed)?;
         for (i, b) in secondary.iter().enumerate() {
             std::fs::write(
                 dir.join(format!("branch_{}.csv", i + 1)),

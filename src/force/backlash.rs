@@ -178,9 +178,7 @@ impl ForceLaw for Backlash {
         jump_angles(&self.stiffness.jumps(), self.teeth, self.phase)
     }
     fn time_order(&self) -> Option<usize> {
-        let constant = matches!(self.stiffness, MeshProfile::Constant { .. })
-            || matches!(self.stiffness, MeshProfile::Cosine { amplitude, .. } if amplitude == 0.0);
-        (!constant).then_some(self.teeth as usize)
+        self.stiffness.time_order(self.teeth)
     }
     fn band_limited(&self, samples: usize, max_order: usize) -> Option<Box<dyn ForceLaw>> {
         let stiffness = self

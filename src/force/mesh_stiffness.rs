@@ -120,9 +120,7 @@ impl ForceLaw for MeshStiffness {
         jump_angles(&self.profile.jumps(), self.teeth, self.phase)
     }
     fn time_order(&self) -> Option<usize> {
-        let constant = matches!(self.profile, MeshProfile::Constant { .. })
-            || matches!(self.profile, MeshProfile::Cosine { amplitude, .. } if amplitude == 0.0);
-        (!constant).then_some(self.teeth as usize)
+        self.profile.time_order(self.teeth)
     }
     fn band_limited(&self, samples: usize, max_order: usize) -> Option<Box<dyn ForceLaw>> {
         let profile = self

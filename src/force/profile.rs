@@ -267,6 +267,15 @@ impl MeshProfile {
         }
     }
 
+    /// The order at which a mesh of `teeth` cycles per period with this profile varies in
+    /// time ([`ForceLaw::time_order`](super::ForceLaw::time_order)): `teeth`, or `None` for a
+    /// profile that does not vary.
+    pub fn time_order(&self, teeth: u32) -> Option<usize> {
+        let constant = matches!(self, MeshProfile::Constant { .. })
+            || matches!(self, MeshProfile::Cosine { amplitude, .. } if *amplitude == 0.0);
+        (!constant).then_some(teeth as usize)
+    }
+
     /// Fractions `m ∈ [0, 1)` of the mesh cycle where the stiffness jumps.
     pub fn jumps(&self) -> Vec<f64> {
         match self {
