@@ -81,9 +81,14 @@ enum Command {
         /// Print exactly one JSON object on stdout instead of the summary.
         #[arg(long)]
         json: bool,
-        /// Write branch.csv and frequency_response.svg into this directory.
+        /// Write branch.csv, frequency_response_<dof>.svg, order_cuts.csv, order_cuts.svg and
+        /// waterfall.svg into this directory.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// The element or DOF whose order cuts and waterfall are plotted (default: the first
+        /// gear stage's transmission error, else the DOF that moves most).
+        #[arg(long, value_name = "NAME")]
+        output: Option<String>,
         /// Skip the error estimate of every point (a solve with 2H harmonics per point).
         #[arg(long)]
         no_error_estimate: bool,
@@ -200,7 +205,11 @@ fn main() -> ExitCode {
             no_error_estimate,
             parameter,
             points,
+            output,
         } => match parameter {
+            Some(_) if output.is_some() => Err(cli::Failure::from(anyhow::anyhow!(
+                "--output chooses the order-cut plot of a speed sweep; it does not apply to --parameter sweeps"
+            ))),
             Some(_) if all_branches => Err(cli::Failure::from(anyhow::anyhow!(
                 "--all-branches follows branches in the speed; it does not apply to --parameter sweeps"
             ))),
@@ -232,6 +241,7 @@ fn main() -> ExitCode {
                     out: out.as_deref(),
                     all_branches,
                     error_estimate: !no_error_estimate,
+                    output: output.as_deref(),
                 },
             ),
         },

@@ -87,7 +87,7 @@ fn solve_json_matches_the_library_and_writes_outputs() {
         assert!(dir.join(f).exists(), "{f}");
     }
     let csv = std::fs::read_to_string(dir.join("harmonics.csv")).unwrap();
-    assert!(csv.starts_with("dof,order,cos,sin\ngear,0,"));
+    assert!(csv.starts_with("dof,harmonic,shaft_order,cos,sin\ngear,0,0,"));
     // Overrides.
     let out = hbal(&[
         "solve",
@@ -355,7 +355,8 @@ fn sweep_follows_the_backlash_branch_through_its_folds() {
     );
     assert!(points.iter().any(|p| p["bifurcation"] == "Fold"));
     let csv = std::fs::read_to_string(dir.join("branch.csv")).unwrap();
-    assert!(csv.starts_with("rad_s,stable,fold,bifurcation,max_abs_x,amp_x_0"));
+    assert!(csv
+        .starts_with("rad_s,stable,fold,bifurcation,max_abs_x,amp_x_k0_order_0,amp_x_k1_order_1"));
     assert!(csv.lines().next().unwrap().ends_with(
         ",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed,error_estimate"
     ));

@@ -242,3 +242,40 @@ pub(crate) fn excitation_orders(
     ks.dedup();
     ks.into_iter().map(|k| (k as f64 * f, k)).collect()
 }
+
+/// Makes `--out DIR` ready before any work: creates it and writes and removes a probe file,
+/// so that an unwritable directory is bad input (exit 2) instead of a failure after the run.
+pub(crate) fn prepare_out(dir: &Path) -> Result<(), Failure> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("--out {}: cannot create the directory", dir.display()))?;
+    let probe = dir.join(".hbal_write_test");
+    std::fs::write(&probe, b"")
+        .with_context(|| format!("--out {}: cannot write into the directory", dir.display()))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
+
+/// Checks that `name` (of a DOF or an element, `what`) can be part of a file name in `--out`:
+/// no path separators, no control characters, not empty, not `.` or `..`; nothing is written
+/// outside `--out`.
+///
+/// ```ignore
+/// assert!(file_name_part("gear", "DOF").is_ok());
+/// assert!(file_name_part("../gear", "DOF").is_err());
+/// ```
+pub(crate) fn file_name_part(name: &str, what: &str) -> Result<(), Failure> {
+    let bad = name.is_empty()
+        || name == "."
+        || name == ".."
+        || name
+            .chars()
+            .any(|c| c == '/' || c == '\\' || c == ':' || c.is_control());
+    if bad {
+        return Err(anyhow::anyhow!(
+            "{what} `{}` cannot be part of a file name in --out (no `/`, `\\`, `:`, control characters, `.` or `..`): rename it",
+            name.escape_debug()
+        )
+        .into());
+    }
+    Ok(())
+}

@@ -1,11 +1,14 @@
 //! Order cuts of a speed sweep: for every point of the branch, the amplitude and phase of each
 //! excitation order (the scene's load orders and mesh orders, as multiples of the reference
-//! speed) of every DOF (up to 50 DOFs) and every element coordinate, and the fraction of the period each
-//! contact spends open: `order_cuts.csv`, and `order_cuts.svg` for the first gear stage's
-//! transmission error (else the DOF that moves most).
+//! speed) of every DOF (up to 50 DOFs) and every element coordinate, and the fraction of the
+//! period each contact spends open: `order_cuts.csv`; for one chosen output (`--output`, by
+//! default the first gear stage's transmission error, else the DOF that moves most) the order
+//! cuts `order_cuts.svg` and the waterfall of its spectrum over speed `waterfall.svg`.
 
-use hbal::continuation::Branch;
-use hbal::report::{element_outputs, line_plot, Axis, ElementOutput, Series};
+use hbal::continuation::{Branch, BranchPoint};
+use hbal::report::{
+    element_outputs, line_plot, waterfall_plot, Axis, ElementOutput, Series, Slice, Waterfall,
+};
 use hbal::scene::Scene;
 use hbal::{HarmonicBasis, Solution};
 use std::path::Path;
@@ -13,13 +16,129 @@ use std::path::Path;
 /// Most DOFs with columns of their own in `order_cuts.csv`.
 const MAX_DOF_COLUMNS: usize = 50;
 
-/// Writes `order_cuts.csv` and `order_cuts.svg` for `branch` (computed on `basis`) into `dir`.
+/// The output the order-cut plot and the waterfall show.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Shown {
+    /// An element's coordinate (a gear stage's transmission error in µm or µrad).
+    Element(usize),
+    /// A DOF.
+    Dof(usize),
+    /// The DOF with the largest dynamic amplitude along the branch.
+    LargestDof,
+}
+
+/// The output named `name` (an element, else a DOF), or the default: the first gear stage,
+/// else the DOF that moves most. An unknown name is bad input that lists the names.
+pub(crate) fn choose(scene: &Scene, name: Option<&str>) -> anyhow::Result<Shown> {
+    let elements = scene.model.elements();
+    let Some(name) = name else {
+        return Ok(elements
+            .iter()
+            .position(|e| e.gear_stage().is_some())
+            .map_or(Shown::LargestDof, Shown::Element));
+    };
+    if let Some(i) = elements.iter().position(|e| e.name() == name) {
+        return Ok(Shown::Element(i));
+    }
+    if let Some(i) = scene.model.dof_names().iter().position(|d| d == name) {
+        return Ok(Shown::Dof(i));
+    }
+    let list = |names: Vec<&str>| {
+        let more = names.len().saturating_sub(12);
+        let mut s = names.into_iter().take(12).collect::<Vec<_>>().join(", ");
+        if more > 0 {
+            s.push_str(&format!(" and {more} more"));
+        }
+        s
+    };
+    Err(anyhow::anyhow!(
+        "{}: --output `{name}` is neither an element ({}) nor a DOF ({})",
+        scene.file,
+        list(elements.iter().map(|e| e.name()).collect()),
+        list(scene.model.dof_names().iter().map(String::as_str).collect()),
+    ))
+}
+
+/// What `shown` is on `branch`: a function from (point, its element outputs, harmonic k) to
+/// the amplitude, its name and unit.
+#[allow(clippy::type_complexity)]
+fn shown_amplitude<'a>(
+    scene: &'a Scene,
+    branch: &'a Branch,
+    shown: Shown,
+) -> (
+    Box<dyn Fn(&BranchPoint, &[ElementOutput], usize) -> f64 + 'a>,
+    String,
+    &'static str,
+) {
+    let n = branch.dofs.len();
+    let dof = |i: usize| -> (
+        Box<dyn Fn(&BranchPoint, &[ElementOutput], usize) -> f64>,
+        String,
+    ) {
+        (
+            Box::new(move |p: &BranchPoint, _: &[ElementOutput], k: usize| {
+                p.harmonics[k * n + i].norm()
+            }),
+            format!("DOF {}", branch.dofs[i]),
+        )
+    };
+    match shown {
+        Shown::Element(s) => {
+            let e = &scene.model.elements()[s];
+            match e.gear_stage() {
+                Some(stage) => (
+                    Box::new(move |_, o: &[ElementOutput], k| {
+                        1e6 * o[s].coordinate.harmonics[k].norm()
+                    }),
+                    format!("transmission error of {}", e.name()),
+                    if stage.base_radii.is_some() {
+                        "µm"
+                    } else {
+                        "µrad"
+                    },
+                ),
+                None => (
+                    Box::new(move |_, o: &[ElementOutput], k| o[s].coordinate.harmonics[k].norm()),
+                    format!("coordinate of {}", e.name()),
+                    "m or rad",
+                ),
+            }
+        }
+        Shown::Dof(i) => {
+            let (f, name) = dof(i);
+            (f, name, "rad or m")
+        }
+        Shown::LargestDof => {
+            let moves = |i: usize| {
+                branch
+                    .points
+                    .iter()
+                    .map(|p| {
+                        (1..=branch.harmonics)
+                            .map(|k| p.harmonics[k * n + i].norm())
+                            .sum::<f64>()
+                    })
+                    .fold(0.0f64, f64::max)
+            };
+            let top = (0..n)
+                .max_by(|&a, &b| moves(a).total_cmp(&moves(b)))
+                .unwrap_or(0);
+            let (f, name) = dof(top);
+            (f, format!("largest response ({name})"), "rad or m")
+        }
+    }
+}
+
+/// Writes `order_cuts.csv`, `order_cuts.svg` and `waterfall.svg` for `branch` (computed on
+/// `basis`) into `dir`, the plots of `shown`.
 pub(crate) fn write(
     dir: &Path,
     scene: &Scene,
     branch: &Branch,
     basis: &HarmonicBasis,
     outputs: &[Vec<ElementOutput>],
+    shown: Shown,
     speed: impl Fn(f64) -> f64,
 ) -> anyhow::Result<()> {
     let orders = super::excitation_orders(scene, basis);
@@ -52,13 +171,14 @@ pub(crate) fn write(
         header.push(format!("open_{}", scene.model.elements()[i].name()));
     }
     w.write_record(&header)?;
-    // The plotted output: the first gear stage's TE in µm, else the DOF that moves most.
-    let stage = scene
-        .model
-        .elements()
-        .iter()
-        .position(|e| e.gear_stage().is_some());
+    let (amplitude, what, unit) = shown_amplitude(scene, branch, shown);
     let mut curves: Vec<Vec<(f64, f64)>> = vec![Vec::new(); orders.len()];
+    // The waterfall's orders: up to twice the highest excitation harmonic (at least 4).
+    let top_k = orders.iter().map(|o| o.1).max().unwrap_or(1);
+    let stems = (2 * top_k).max(4).min(branch.harmonics);
+    let order_of =
+        |k: usize| super::element_report::order_of(k, scene.fundamental_order, basis.subharmonic());
+    let mut slices = Vec::with_capacity(branch.points.len());
     for (p, outputs) in branch.points.iter().zip(outputs) {
         let mut row = vec![format!("{:e}", speed(p.omega))];
         let harmonic_of = |name: usize, k: usize| {
@@ -90,26 +210,16 @@ pub(crate) fn write(
         }
         w.write_record(&row)?;
         for (c, &(_, k)) in curves.iter_mut().zip(&orders) {
-            let a = match stage {
-                Some(s) => 1e6 * outputs[s].coordinate.harmonics[k].norm(),
-                None => {
-                    let top = (0..n)
-                        .max_by(|&a, &b| p.max_abs[a].total_cmp(&p.max_abs[b]))
-                        .unwrap_or(0);
-                    p.harmonics[k * n + top].norm()
-                }
-            };
-            c.push((speed(p.omega), a));
+            c.push((speed(p.omega), amplitude(p, outputs, k)));
         }
+        slices.push(Slice {
+            speed: speed(p.omega),
+            amplitudes: (1..=stems)
+                .map(|k| (order_of(k), amplitude(p, outputs, k)))
+                .collect(),
+        });
     }
     w.flush()?;
-    let (what, unit) = match stage {
-        Some(s) => (
-            format!("transmission error of {}", scene.model.elements()[s].name()),
-            "µm",
-        ),
-        None => ("largest response".to_string(), "rad or m"),
-    };
     let series: Vec<Series> = curves
         .into_iter()
         .zip(&orders)
@@ -120,8 +230,23 @@ pub(crate) fn write(
             &dir.join("order_cuts.svg"),
             &format!("Order cuts of the {what}: {}", scene.file),
             &Axis::linear(format!("speed ({})", scene.speed_unit)),
-            &Axis::log(format!("amplitude ({unit})")),
+            &Axis::auto(format!("amplitude ({unit})")),
             &series,
+        )
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    }
+    if branch.points.len() >= 2 && stems > 0 {
+        let highlight: Vec<f64> = orders.iter().map(|o| o.0).collect();
+        waterfall_plot(
+            &dir.join("waterfall.svg"),
+            &Waterfall {
+                title: &format!("Waterfall of the {what}: {}", scene.file),
+                speed_label: &format!("speed ({})", scene.speed_unit),
+                unit,
+                range_db: 60.0,
+                highlight: &highlight,
+            },
+            &slices,
         )
         .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
     }

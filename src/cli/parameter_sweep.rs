@@ -58,6 +58,12 @@ pub(crate) fn parameter_sweep(
         .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
     let probe = Scene::from_value(probe, &file)?;
     basis_with(&probe.basis, opts.solver, &file)?;
+    if let Some(dir) = out {
+        for dof in probe.model.dof_names() {
+            super::file_name_part(dof, "DOF")?;
+        }
+        super::prepare_out(dir)?;
+    }
     let values: Vec<f64> = (0..points)
         .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
         .collect();
@@ -134,7 +140,7 @@ pub(crate) fn parameter_sweep(
         std::fs::create_dir_all(dir)?;
         std::fs::write(
             dir.join("branch.csv"),
-            hbal::report::branch_csv(&branch, name, |p| p),
+            hbal::report::branch_csv_orders(&branch, probe.fundamental_order, name, |p| p),
         )?;
         if branch.points.len() >= 2 {
             for (i, dof) in branch.dofs.iter().enumerate() {

@@ -117,7 +117,8 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 "max_abs": max_abs[i],
                 "harmonics": (0..=sol.basis().harmonics()).map(|k| {
                     let (c, s) = sol.cos_sin(i, k);
-                    json!({"order": k, "cos": c, "sin": s})
+                    // `order` is the harmonic index, kept for `--start` files.
+                    json!({"order": k, "harmonic": k, "shaft_order": order(k), "cos": c, "sin": s})
                 }).collect::<Vec<_>>(),
             })
         })
@@ -290,7 +291,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             ),
             prefix,
         };
-        write_outputs(dir, &sol, &label)?;
+        write_outputs(dir, &sol, &label, order)?;
         if let Ok(e) = &elements {
             element_report::write_csv(&dir.join(format!("{prefix}elements.csv")), e, order)
                 .with_context(|| format!("--out: cannot write {}", dir.display()))?;
@@ -326,19 +327,25 @@ struct OutputLabel {
     prefix: &'static str,
 }
 
-fn write_outputs(dir: &Path, sol: &Solution, label: &OutputLabel) -> anyhow::Result<()> {
+fn write_outputs(
+    dir: &Path,
+    sol: &Solution,
+    label: &OutputLabel,
+    order: impl Fn(usize) -> f64,
+) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let file = |name: &str| dir.join(format!("{}{name}", label.prefix));
     let h = sol.basis().harmonics();
     // CSV through the csv writer: a DOF name with a comma or a quote is quoted.
     let mut w = csv::Writer::from_path(file("harmonics.csv"))?;
-    w.write_record(["dof", "order", "cos", "sin"])?;
+    w.write_record(["dof", "harmonic", "shaft_order", "cos", "sin"])?;
     for (i, name) in sol.dof_names().iter().enumerate() {
         for k in 0..=h {
             let (c, s) = sol.cos_sin(i, k);
             w.write_record([
                 name.clone(),
                 k.to_string(),
+                order(k).to_string(),
                 format!("{c:e}"),
                 format!("{s:e}"),
             ])?;

@@ -26,6 +26,8 @@ pub(crate) struct SweepOptions<'a> {
     pub(crate) all_branches: bool,
     /// Estimate the error of every point against 2H.
     pub(crate) error_estimate: bool,
+    /// The element or DOF the order-cut plot and the waterfall show.
+    pub(crate) output: Option<&'a str>,
 }
 
 /// The branch from `basis.omega()` to `to`, from the orbit `initial` if given.
@@ -40,9 +42,15 @@ fn run(
     continuation.run_from(model, basis, to, initial, progress)
 }
 
-/// One point of a branch as JSON; harmonic k of a branch with period multiple ν is shaft
-/// order k/ν.
-fn point_json(p: &BranchPoint, branch: &Branch, speed: impl Fn(f64) -> f64) -> serde_json::Value {
+/// One point of a branch as JSON; harmonic k of a branch with period multiple ν is order
+/// `k · fundamental_order / ν` of the reference shaft (`shaft_order`; `order` is kept as it
+/// was: k, or k/ν on a period-multiplied branch).
+fn point_json(
+    p: &BranchPoint,
+    branch: &Branch,
+    fundamental_order: f64,
+    speed: impl Fn(f64) -> f64,
+) -> serde_json::Value {
     let n = branch.dofs.len();
     let nu = branch.subharmonic.max(1);
     let f = p.floquet.as_ref();
@@ -66,10 +74,11 @@ fn point_json(p: &BranchPoint, branch: &Branch, speed: impl Fn(f64) -> f64) -> s
         "polished": f.map(|f| f.polished),
         "harmonics": (0..n).map(|i| (0..=branch.harmonics).map(|k| {
             let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
+            let shaft_order = super::element_report::order_of(k, fundamental_order, nu);
             if nu == 1 {
-                json!({"order": k, "cos": c, "sin": s})
+                json!({"order": k, "harmonic": k, "shaft_order": shaft_order, "cos": c, "sin": s})
             } else {
-                json!({"harmonic": k, "order": k as f64 / nu as f64, "cos": c, "sin": s})
+                json!({"harmonic": k, "order": k as f64 / nu as f64, "shaft_order": shaft_order, "cos": c, "sin": s})
             }
         }).collect::<Vec<_>>()).collect::<Vec<_>>(),
     })
@@ -77,7 +86,11 @@ fn point_json(p: &BranchPoint, branch: &Branch, speed: impl Fn(f64) -> f64) -> s
 
 /// A secondary branch as JSON: where it leaves the main branch, its period multiple, its
 /// points and why it ended.
-fn secondary_json(b: &Branch, speed: impl Fn(f64) -> f64 + Copy) -> serde_json::Value {
+fn secondary_json(
+    b: &Branch,
+    fundamental_order: f64,
+    speed: impl Fn(f64) -> f64 + Copy,
+) -> serde_json::Value {
     let origin = b.origin.as_ref();
     json!({
         "bifurcation": origin.map(|o| format!("{:?}", o.bifurcation)),
@@ -89,13 +102,20 @@ fn secondary_json(b: &Branch, speed: impl Fn(f64) -> f64 + Copy) -> serde_json::
         "stop": b.stop.to_string(),
         "reached": b.stop.is_normal_end(),
         "folds": b.folds(),
-        "points": b.points.iter().map(|p| point_json(p, b, speed)).collect::<Vec<_>>(),
+        "points": b.points.iter().map(|p| point_json(p, b, fundamental_order, speed)).collect::<Vec<_>>(),
     })
 }
 
 pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
     let (to, as_json, out, max_step) = (opts.to, opts.json, opts.out, opts.max_step);
     let scene = load(path, args)?;
+    let shown = super::order_cuts::choose(&scene, opts.output)?;
+    if let Some(dir) = out {
+        for dof in scene.model.dof_names() {
+            super::file_name_part(dof, "DOF")?;
+        }
+        super::prepare_out(dir)?;
+    }
     let unit = scene.speed_unit;
     let per = scene.omega_per_speed;
     let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
@@ -233,7 +253,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         let points: Vec<_> = branch
             .points
             .iter()
-            .map(|p| point_json(p, &branch, speed))
+            .map(|p| point_json(p, &branch, scene.fundamental_order, speed))
             .collect();
         say!(
             "{}",
@@ -251,7 +271,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 "spurious_turns": branch.spurious_turns(),
                 "seconds": seconds,
                 "dofs": branch.dofs,
-                "branches": secondary.iter().map(|b| secondary_json(b, speed)).collect::<Vec<_>>(),
+                "branches": secondary.iter().map(|b| secondary_json(b, scene.fundamental_order, speed)).collect::<Vec<_>>(),
                 "contact_loss": contact_loss,
             })
         );
@@ -338,13 +358,13 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         std::fs::create_dir_all(dir)?;
         std::fs::write(
             dir.join("branch.csv"),
-            hbal::report::branch_csv(&branch, unit, speed),
+            hbal::report::branch_csv_orders(&branch, scene.fundamental_order, unit, speed),
         )?;
-        super::order_cuts::write(dir, &scene, &branch, &basis, &outputs, speed)?;
+        super::order_cuts::write(dir, &scene, &branch, &basis, &outputs, shown, speed)?;
         for (i, b) in secondary.iter().enumerate() {
             std::fs::write(
                 dir.join(format!("branch_{}.csv", i + 1)),
-                hbal::report::branch_csv(b, unit, speed),
+                hbal::report::branch_csv_orders(b, scene.fundamental_order, unit, speed),
             )?;
         }
         if branch.points.len() >= 2 {

@@ -12,15 +12,32 @@ use std::path::Path;
 /// point of the discretised branch ends here that the multipliers do not confirm
 /// (`spurious_turn`), the located position of a bifurcation other than a fold (empty
 /// unless the point closes one) and the point's error estimate (empty if not computed). `parameter(p)` maps the point's swept parameter and the fold position to
-/// the parameter's unit (e.g. Ω to rpm).
+/// the parameter's unit (e.g. Ω to rpm). The amplitude columns `amp_<dof>_k<k>_order_<o>` name
+/// the harmonic k and its order o = k/ν of the fundamental (ν the branch's period multiple);
+/// [`branch_csv_orders`] states the fundamental's order of a reference shaft.
 pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
+    branch_csv_orders(branch, 1.0, parameter_name, parameter)
+}
+
+/// [`branch_csv`] with harmonic k named as order `k · fundamental_order / ν` of the reference
+/// shaft.
+pub fn branch_csv_orders(
+    branch: &Branch,
+    fundamental_order: f64,
+    parameter_name: &str,
+    parameter: impl Fn(f64) -> f64,
+) -> String {
+    let nu = branch.subharmonic.max(1) as f64;
     let mut header: Vec<String> = [parameter_name, "stable", "fold", "bifurcation"]
         .iter()
         .map(|s| s.to_string())
         .collect();
     header.extend(branch.dofs.iter().map(|d| format!("max_abs_{d}")));
     for d in &branch.dofs {
-        header.extend((0..=branch.harmonics).map(|k| format!("amp_{d}_{k}")));
+        header.extend(
+            (0..=branch.harmonics)
+                .map(|k| format!("amp_{d}_k{k}_order_{}", k as f64 * fundamental_order / nu)),
+        );
     }
     header.extend(
         [

@@ -5,9 +5,13 @@ mod element_output;
 mod modes;
 mod plot;
 mod timing;
+mod waterfall;
 
-pub use branch::{branch_csv, branch_plot, branches_plot};
+pub use branch::{branch_csv, branch_csv_orders, branch_plot, branches_plot};
 pub use element_output::{element_outputs, ElementOutput, MeshOutput, Signal};
 pub use modes::{natural_frequencies, NaturalFrequencies};
 pub use plot::{line_plot, tick_label, Axis, Series};
 pub use timing::median_time;
+pub use waterfall::{
+    stem_height, thin_slices, waterfall_plot, Slice, Waterfall, MAX_SLICES, SLICE_HEIGHT,
+};

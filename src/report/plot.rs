@@ -52,13 +52,16 @@ impl Series {
     }
 }
 
-/// An axis: label and whether it is logarithmic.
+/// An axis: label and scale.
 #[derive(Debug, Clone)]
 pub struct Axis {
-    /// Label.
+    /// Label, with the unit in parentheses.
     pub label: String,
     /// Logarithmic scale (non-positive values are dropped).
     pub log: bool,
+    /// Choose the scale from the data: logarithmic where every value is positive and they span
+    /// more than two decades, else linear (`log` is then ignored).
+    pub auto: bool,
 }
 
 impl Axis {
@@ -67,19 +70,45 @@ impl Axis {
         Self {
             label: label.into(),
             log: false,
+            auto: false,
         }
     }
 
     /// A logarithmic axis.
     pub fn log(label: impl Into<String>) -> Self {
         Self {
-            label: label.into(),
             log: true,
+            ..Self::linear(label)
         }
+    }
+
+    /// An axis that is logarithmic where the values span more than two decades.
+    pub fn auto(label: impl Into<String>) -> Self {
+        Self {
+            auto: true,
+            ..Self::linear(label)
+        }
+    }
+
+    /// Whether the axis is logarithmic for `values`.
+    fn is_log(&self, values: impl Iterator<Item = f64>) -> bool {
+        if !self.auto {
+            return self.log;
+        }
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for v in values.filter(|v| v.is_finite()) {
+            if v <= 0.0 {
+                return false;
+            }
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        hi > 100.0 * lo
     }
 }
 
-const COLORS: [plotters::style::RGBColor; 6] = [
+/// The palette: series `i` is drawn in `COLORS[i % 6]`.
+pub(super) const COLORS: [plotters::style::RGBColor; 6] = [
     plotters::style::RGBColor(0, 0, 0),
     plotters::style::RGBColor(214, 39, 40),
     plotters::style::RGBColor(31, 119, 180),
@@ -88,7 +117,11 @@ const COLORS: [plotters::style::RGBColor; 6] = [
     plotters::style::RGBColor(255, 127, 14),
 ];
 
-/// Writes an SVG with the given curves to `path`.
+/// Most legend rows; further series are summed up in one line.
+pub(super) const LEGEND_ROWS: usize = 24;
+
+/// Writes an SVG with the given curves to `path`: the data fill the chart, the legend stands
+/// to its right, outside the data.
 pub fn line_plot(
     path: &Path,
     title: &str,
@@ -97,14 +130,21 @@ pub fn line_plot(
     series: &[Series],
 ) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
-    let keep = |a: &Axis, v: f64| v.is_finite() && (!a.log || v > 0.0);
+    let finite: Vec<(f64, f64)> = series
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .collect();
+    let x_log = x.is_log(finite.iter().map(|p| p.0));
+    let y_log = y.is_log(finite.iter().map(|p| p.1));
+    let keep = |log: bool, v: f64| v.is_finite() && (!log || v > 0.0);
     let pts: Vec<Vec<(f64, f64)>> = series
         .iter()
         .map(|s| {
             s.points
                 .iter()
                 .copied()
-                .filter(|&(px, py)| keep(x, px) && keep(y, py))
+                .filter(|&(px, py)| keep(x_log, px) && keep(y_log, py))
                 .collect()
         })
         .collect();
@@ -129,26 +169,29 @@ pub fn line_plot(
             (lo - 1.0, hi + 1.0)
         }
     };
-    let (x0, x1) = pad(x0, x1, x.log);
-    let (y0, mut y1) = pad(y0, y1, y.log);
-    // Head room for the legend (upper right) so it does not cover the curves.
-    let rows = series
+    let (x0, x1) = pad(x0, x1, x_log);
+    let (y0, y1) = pad(y0, y1, y_log);
+    let labelled: Vec<(usize, &Series)> = series
         .iter()
-        .filter(|s| !s.label.is_empty())
-        .count()
-        .min(12) as f64;
-    if y.log {
-        y1 *= 10f64.powf(0.12 * rows * (y1 / y0).log10().max(1.0) / 4.0);
-    } else {
-        y1 += 0.09 * rows * (y1 - y0);
-    }
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+        .enumerate()
+        .filter(|(_, s)| !s.label.is_empty())
+        .collect();
+    // The legend's width from its longest label (about 8 px per character at 15 px).
+    let legend_width = labelled
+        .iter()
+        .take(LEGEND_ROWS)
+        .map(|(_, s)| 50 + 8 * s.label.chars().count() as u32)
+        .max()
+        .map_or(0, |w| w.clamp(120, 320));
+    let root = SVGBackend::new(path, (900 + legend_width, 560)).into_drawing_area();
     root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 20))?;
+    let (plot_area, legend_area) = root.split_horizontally(900);
     macro_rules! draw {
         ($chart:expr) => {{
             let mut chart = $chart;
-            let fmt_x = |v: &f64| axis_tick_label(*v, x0, x1, x.log);
-            let fmt_y = |v: &f64| axis_tick_label(*v, y0, y1, y.log);
+            let fmt_x = |v: &f64| axis_tick_label(*v, x0, x1, x_log);
+            let fmt_y = |v: &f64| axis_tick_label(*v, y0, y1, y_log);
             chart
                 .configure_mesh()
                 .x_desc(x.label.as_str())
@@ -158,50 +201,27 @@ pub fn line_plot(
                 .draw()?;
             for (i, (s, p)) in series.iter().zip(&pts).enumerate() {
                 let color = COLORS[s.color.unwrap_or(i) % COLORS.len()];
-                let labelled = !s.label.is_empty();
                 if s.markers {
-                    let a =
-                        chart.draw_series(p.iter().map(|&c| Circle::new(c, 4, color.filled())))?;
-                    if labelled {
-                        a.label(s.label.as_str())
-                            .legend(move |(lx, ly)| Circle::new((lx + 10, ly), 4, color.filled()));
-                    }
+                    chart.draw_series(p.iter().map(|&c| Circle::new(c, 3, color.filled())))?;
                 } else if s.dashed {
-                    let a = chart.draw_series(DashedLineSeries::new(
+                    chart.draw_series(DashedLineSeries::new(
                         p.iter().copied(),
                         6,
                         4,
                         color.stroke_width(2),
                     ))?;
-                    if labelled {
-                        a.label(s.label.as_str()).legend(move |(lx, ly)| {
-                            PathElement::new(vec![(lx, ly), (lx + 8, ly)], color.stroke_width(2))
-                        });
-                    }
                 } else {
-                    let a = chart
-                        .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))?;
-                    if labelled {
-                        a.label(s.label.as_str()).legend(move |(lx, ly)| {
-                            PathElement::new(vec![(lx, ly), (lx + 20, ly)], color.stroke_width(2))
-                        });
-                    }
+                    chart.draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))?;
                 }
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()?;
         }};
     }
-    let mut builder = ChartBuilder::on(&root);
+    let mut builder = ChartBuilder::on(&plot_area);
     builder
-        .caption(title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(80);
-    match (x.log, y.log) {
+    match (x_log, y_log) {
         (false, false) => draw!(builder.build_cartesian_2d(x0..x1, y0..y1)?),
         (false, true) => draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?),
         (true, false) => draw!(builder.build_cartesian_2d((x0..x1).log_scale(), y0..y1)?),
@@ -209,7 +229,56 @@ pub fn line_plot(
             draw!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?)
         }
     }
+    draw_legend(&legend_area, series, &labelled)?;
     root.present()?;
+    Ok(())
+}
+
+/// The legend in its own area right of the chart: a sample of each labelled series (line,
+/// dashes or marker in its colour) and its label, one row each.
+pub(super) fn draw_legend<DB: plotters::prelude::DrawingBackend>(
+    area: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    series: &[Series],
+    labelled: &[(usize, &Series)],
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    use plotters::prelude::*;
+    let font = ("sans-serif", 15).into_font();
+    let row = 22;
+    for (r, &(i, s)) in labelled.iter().take(LEGEND_ROWS).enumerate() {
+        let y = 30 + row * r as i32;
+        let color = COLORS[series[i].color.unwrap_or(i) % COLORS.len()];
+        if s.markers {
+            area.draw(&Circle::new((20, y), 4, color.filled()))?;
+        } else if s.dashed {
+            for x in [4, 16, 28] {
+                area.draw(&PathElement::new(
+                    vec![(x, y), (x + 7, y)],
+                    color.stroke_width(2),
+                ))?;
+            }
+        } else {
+            area.draw(&PathElement::new(
+                vec![(4, y), (36, y)],
+                color.stroke_width(2),
+            ))?;
+        }
+        area.draw(&Text::new(
+            s.label.clone(),
+            (44, y - 8),
+            font.clone().color(&BLACK),
+        ))?;
+    }
+    if labelled.len() > LEGEND_ROWS {
+        let y = 30 + row * LEGEND_ROWS as i32;
+        area.draw(&Text::new(
+            format!("… and {} more", labelled.len() - LEGEND_ROWS),
+            (4, y - 8),
+            font.color(&BLACK),
+        ))?;
+    }
     Ok(())
 }
 
@@ -262,4 +331,35 @@ fn axis_tick_label(v: f64, lo: f64, hi: f64, log: bool) -> String {
     }
     let magnitude = v.abs().max(f64::MIN_POSITIVE);
     tick_label(v, v - 0.001 * magnitude, v + 0.001 * magnitude)
+}
+
+/// `x` with `digits` significant digits, without trailing zeros; scientific notation outside
+/// `[1e-3, 1e6)`.
+///
+/// ```ignore
+/// assert_eq!(significant(19.4321, 4), "19.43");
+/// assert_eq!(significant(2.5e-7, 4), "2.5e-7");
+/// ```
+pub(super) fn significant(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let trim = |s: String| {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    };
+    let e = x.abs().log10().floor() as i32;
+    if (-3..6).contains(&e) {
+        let decimals = (digits as i32 - 1 - e).max(0) as usize;
+        trim(format!("{x:.decimals$}"))
+    } else {
+        let s = format!("{x:.prec$e}", prec = digits.saturating_sub(1));
+        match s.split_once('e') {
+            Some((m, ex)) => format!("{}e{ex}", trim(m.to_string())),
+            None => s,
+        }
+    }
 }
