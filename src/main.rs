@@ -133,6 +133,33 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// One self-contained report.html: the solve at the scene's speed, with --to the run-up
+    /// (order cuts, waterfall, frequency responses), natural frequencies and the Campbell
+    /// diagram, the scene and its settings.
+    ///
+    /// --from and --to are in the scene's speed unit; the CSV files and plots stay in
+    /// DIR/solve, DIR/sweep and DIR/modes.
+    Report {
+        /// Scene file (.toml or .json).
+        scene: PathBuf,
+        /// Start speed of the run-up (default: the scene's speed).
+        #[arg(long, allow_negative_numbers = true)]
+        from: Option<f64>,
+        /// End speed of the run-up (no run-up without it).
+        #[arg(long, allow_negative_numbers = true)]
+        to: Option<f64>,
+        /// The directory of report.html (created; checked writable before any work).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// The element or DOF of the run-up's order cuts and waterfall.
+        #[arg(long, value_name = "NAME")]
+        output: Option<String>,
+        /// Skip the Floquet stability.
+        #[arg(long)]
+        no_stability: bool,
+        #[command(flatten)]
+        solver: cli::SolverArgs,
+    },
     /// Validate a scene without solving.
     Check {
         /// Scene file (.toml or .json).
@@ -162,6 +189,7 @@ fn main() -> ExitCode {
                 stability: !no_stability,
                 json,
                 out: out.as_deref(),
+                capture: None,
             },
         ),
         Command::Compare {
@@ -171,6 +199,25 @@ fn main() -> ExitCode {
             out,
         } => cli::compare::compare(&scene, &solver, json, out.as_deref()),
         Command::Check { scene } => cli::check::check(&scene),
+        Command::Report {
+            scene,
+            from,
+            to,
+            out,
+            output,
+            no_stability,
+            solver,
+        } => cli::report::report(
+            &scene,
+            &solver,
+            cli::report::ReportOptions {
+                from,
+                to,
+                stability: !no_stability,
+                out: &out,
+                output: output.as_deref(),
+            },
+        ),
         Command::Modes {
             scene,
             from,
@@ -188,6 +235,7 @@ fn main() -> ExitCode {
                 max_hz,
                 json,
                 out: out.as_deref(),
+                capture: None,
             },
         ),
         Command::Sweep {
@@ -242,6 +290,7 @@ fn main() -> ExitCode {
                     all_branches,
                     error_estimate: !no_error_estimate,
                     output: output.as_deref(),
+                    capture: None,
                 },
             ),
         },

@@ -28,6 +28,8 @@ pub(crate) mod element_report;
 pub(crate) mod modes;
 pub(crate) mod order_cuts;
 pub(crate) mod parameter_sweep;
+pub(crate) mod report;
+pub(crate) mod report_html;
 pub(crate) mod solve;
 pub(crate) mod start;
 pub(crate) mod sweep;
@@ -241,6 +243,18 @@ pub(crate) fn excitation_orders(
     ks.sort_unstable();
     ks.dedup();
     ks.into_iter().map(|k| (k as f64 * f, k)).collect()
+}
+
+/// Where a subcommand's JSON document goes when it is kept instead of printed: `hbal report`
+/// runs `solve`, `sweep` and `modes` and reads their documents from here.
+pub(crate) type Capture<'a> = Option<&'a mut Option<serde_json::Value>>;
+
+/// Prints `doc` on stdout, or keeps it in `capture`.
+pub(crate) fn emit(doc: serde_json::Value, capture: Capture) {
+    match capture {
+        Some(slot) => *slot = Some(doc),
+        None => say!("{doc}"),
+    }
 }
 
 /// Makes `--out DIR` ready before any work: creates it and writes and removes a probe file,

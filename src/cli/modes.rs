@@ -18,10 +18,16 @@ pub(crate) struct ModesOptions<'a> {
     pub(crate) max_hz: Option<f64>,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
+    /// Keep the JSON document here instead of printing anything (for `hbal report`).
+    pub(crate) capture: super::Capture<'a>,
 }
 
 pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Result<u8, Failure> {
+    let as_json = opts.json || opts.capture.is_some();
     let scene = load(path, args)?;
+    if let Some(dir) = opts.out {
+        super::prepare_out(dir)?;
+    }
     let speed = scene.basis.omega() / scene.omega_per_speed;
     let (from, to) = (opts.from.unwrap_or(0.0), opts.to.unwrap_or(2.0 * speed));
     if !(from.is_finite() && to.is_finite() && from >= 0.0 && to > from) {
@@ -75,7 +81,7 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
         .filter(|&(_, _, s)| s >= from && s <= to)
         .collect();
     let unit = scene.speed_unit;
-    if opts.json {
+    if as_json {
         let doc = json!({
             "scene": scene.file,
             "unit": unit,
@@ -93,7 +99,7 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
                 "order": o, "mode": i + 1, "speed": s,
             })).collect::<Vec<_>>(),
         });
-        say!("{doc}");
+        super::emit(doc, opts.capture);
     } else {
         say!(
             "{}: {} modes up to {} ({} rigid), linearised on the orbit at {speed} {unit}",
@@ -132,7 +138,7 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--out: cannot create {}", dir.display()))?;
         write_outputs(dir, &scene, &nf, &orders, (from, to), per_unit)?;
-        if !opts.json {
+        if !as_json {
             say!("  wrote modes.csv, campbell.svg to {}", dir.display());
         }
     }

@@ -17,12 +17,17 @@ pub(crate) struct SolveOptions<'a> {
     pub(crate) stability: bool,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
+    /// Keep the JSON document here instead of printing anything (for `hbal report`).
+    pub(crate) capture: super::Capture<'a>,
 }
 
 pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Result<u8, Failure> {
-    let as_json = opts.json;
+    let as_json = opts.json || opts.capture.is_some();
     let out = opts.out;
     let scene = load(path, args)?;
+    if let Some(dir) = out {
+        super::prepare_out(dir)?;
+    }
     let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
     if let (Some(file), Some(s)) = (opts.start, &start) {
         if let Some(w) = s.omega {
@@ -171,7 +176,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             },
             "history": sol.history,
         });
-        say!("{doc}");
+        super::emit(doc, opts.capture);
     } else {
         say!(
             "{}: {} ({}) after {} iteration{}{}, relative residual {:.2e}, solve {:.3} ms",
@@ -394,6 +399,11 @@ fn write_outputs(
         &lines,
     )
     .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    // Amplitudes below 1e-13 of the largest are rounding noise: left out.
+    let largest = shown
+        .iter()
+        .flat_map(|&i| (1..=h).map(move |k| sol.harmonic(i, k).norm()))
+        .fold(0.0f64, f64::max);
     let spectra: Vec<Series> = shown
         .iter()
         .map(|&i| (i, &names[i]))
@@ -402,6 +412,7 @@ fn write_outputs(
                 name.clone(),
                 (1..=h)
                     .map(|k| (k as f64, sol.harmonic(i, k).norm()))
+                    .filter(|&(_, a)| a > 1e-13 * largest)
                     .collect(),
             )
         })

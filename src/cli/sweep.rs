@@ -28,6 +28,8 @@ pub(crate) struct SweepOptions<'a> {
     pub(crate) error_estimate: bool,
     /// The element or DOF the order-cut plot and the waterfall show.
     pub(crate) output: Option<&'a str>,
+    /// Keep the JSON document here instead of printing anything (for `hbal report`).
+    pub(crate) capture: super::Capture<'a>,
 }
 
 /// The branch from `basis.omega()` to `to`, from the orbit `initial` if given.
@@ -107,7 +109,8 @@ fn secondary_json(
 }
 
 pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
-    let (to, as_json, out, max_step) = (opts.to, opts.json, opts.out, opts.max_step);
+    let as_json = opts.json || opts.capture.is_some();
+    let (to, out, max_step) = (opts.to, opts.out, opts.max_step);
     let scene = load(path, args)?;
     let shown = super::order_cuts::choose(&scene, opts.output)?;
     if let Some(dir) = out {
@@ -255,8 +258,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             .iter()
             .map(|p| point_json(p, &branch, scene.fundamental_order, speed))
             .collect();
-        say!(
-            "{}",
+        super::emit(
             json!({
                 "scene": scene.file,
                 "unit": unit,
@@ -273,7 +275,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 "dofs": branch.dofs,
                 "branches": secondary.iter().map(|b| secondary_json(b, scene.fundamental_order, speed)).collect::<Vec<_>>(),
                 "contact_loss": contact_loss,
-            })
+            }),
+            opts.capture,
         );
     } else {
         let unstable = branch

@@ -1,7 +1,8 @@
-//! Reports: element outputs, SVG plots and timing for tables.
+//! Reports: element outputs, SVG plots, the HTML report and timing for tables.
 
 mod branch;
 mod element_output;
+mod html;
 mod modes;
 mod plot;
 mod timing;
@@ -9,8 +10,9 @@ mod waterfall;
 
 pub use branch::{branch_csv, branch_csv_orders, branch_plot, branches_plot};
 pub use element_output::{element_outputs, ElementOutput, MeshOutput, Signal};
+pub use html::{escape, HtmlReport};
 pub use modes::{natural_frequencies, NaturalFrequencies};
-pub use plot::{line_plot, tick_label, Axis, Series};
+pub use plot::{line_plot, significant, tick_label, Axis, Series};
 pub use timing::median_time;
 pub use waterfall::{
     stem_height, thin_slices, waterfall_plot, Slice, Waterfall, MAX_SLICES, SLICE_HEIGHT,

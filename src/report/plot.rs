@@ -336,11 +336,13 @@ fn axis_tick_label(v: f64, lo: f64, hi: f64, log: bool) -> String {
 /// `x` with `digits` significant digits, without trailing zeros; scientific notation outside
 /// `[1e-3, 1e6)`.
 ///
-/// ```ignore
+/// ```
+/// use hbal::report::significant;
 /// assert_eq!(significant(19.4321, 4), "19.43");
 /// assert_eq!(significant(2.5e-7, 4), "2.5e-7");
+/// assert_eq!(significant(6000.0, 4), "6000");
 /// ```
-pub(super) fn significant(x: f64, digits: usize) -> String {
+pub fn significant(x: f64, digits: usize) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
     }
