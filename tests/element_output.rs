@@ -24,6 +24,36 @@ fn scene(name: &str) -> Scene {
     .unwrap()
 }
 
+/// The paper's two-shaft model (one DOF, `u = q`): the equation of motion
+/// `M q̈ + f(t) = L(t)` gives every harmonic of the mesh force from the DOF harmonics by hand,
+/// `F_k = L_k + (kΩ)² M Q_k`; its mean is the load L0 = 10 N m, and `u` is `q` itself.
+#[test]
+fn two_shaft_mesh_force_from_its_harmonics_by_hand() {
+    let s = scene("two_shaft_6000rpm.toml");
+    let sol = solve(&s, s.basis.omega());
+    let out = element_outputs(&s.model, &sol).unwrap();
+    let mesh = &out[0];
+    assert_eq!(mesh.kind, "mesh_stiffness");
+    let (m, omega) = (1e-3, sol.basis().omega());
+    let load = |k: usize| match k {
+        0 => 10.0,
+        1 => 3.158273408348595,
+        _ => 0.0,
+    };
+    let scale = mesh.force.harmonics[1].norm();
+    for k in 0..=sol.basis().harmonics() {
+        let q = sol.harmonic(0, k);
+        assert!((mesh.coordinate.harmonics[k] - q).norm() <= 1e-15 * q.norm().max(1e-30));
+        let by_hand = load(k) + (k as f64 * omega).powi(2) * m * q;
+        assert!(
+            (mesh.force.harmonics[k] - by_hand).norm() < 1e-9 * scale,
+            "k {k}: {} vs {by_hand}",
+            mesh.force.harmonics[k]
+        );
+    }
+    assert!((mesh.force.mean() - 10.0).abs() < 1e-9);
+}
+
 /// The two-inertia gear pair: `u = r1 θ1 - r2 θ2` from the DOF harmonics; the mean mesh force
 /// from the pinion's static balance `T - k_p θ̄1 - r1 f̄ = 0` (drive torque 20 N m, shaft
 /// 1e4 N m/rad); the dynamic factor `f_max / f̄`.

@@ -19,6 +19,9 @@ pub(crate) fn compare(
     out: Option<&Path>,
 ) -> Result<u8, Failure> {
     let scene = load(path, args)?;
+    if let Some(dir) = out {
+        super::prepare_out(dir)?;
+    }
     let names: Vec<&str> = match &args.method {
         Some(_) => vec![scene.method.name()],
         None => hbal::scene::METHODS.to_vec(),

@@ -103,7 +103,8 @@ pub fn waterfall_plot(
         .flat_map(|s| s.amplitudes.iter().map(|p| p.0))
         .filter(|&o| finite(o))
         .fold(0.0f64, f64::max);
-    if shown.is_empty() || !(max > 0.0) || !(o1 > 0.0) || !(s1 >= s0) {
+    // The folds start at 0 and ±∞ and skip NaN: no NaN reaches these comparisons.
+    if shown.is_empty() || max <= 0.0 || o1 <= 0.0 || s1 < s0 {
         return Err("nothing to plot".into());
     }
     let spacing = if shown.len() > 1 {
