@@ -31,8 +31,10 @@ pub(crate) mod parameter_sweep;
 pub(crate) mod report;
 pub(crate) mod report_html;
 pub(crate) mod solve;
+pub(crate) mod solve_files;
 pub(crate) mod start;
 pub(crate) mod sweep;
+pub(crate) mod sweep_summary;
 
 /// An error with its exit code.
 pub(crate) struct Failure {

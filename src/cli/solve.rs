@@ -2,11 +2,11 @@
 //! `--start` file, compute the orbit's Floquet stability, print a summary or one JSON object, and
 //! optionally write harmonics.csv, time_series.csv and SVG plots.
 
+use super::solve_files::{write_outputs, OutputLabel};
 use super::{element_report, load, multipliers_json, start, Failure, SolverArgs};
 use anyhow::Context;
-use hbal::report::{line_plot, Axis, Series};
 use hbal::stability::Floquet;
-use hbal::{HarmonicBalance, Solution};
+use hbal::HarmonicBalance;
 use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
@@ -324,132 +324,4 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     } else {
         1
     })
-}
-
-/// The plots' title (scene, speed, status) and the file-name prefix of an unconverged solve.
-struct OutputLabel {
-    title: String,
-    prefix: &'static str,
-}
-
-fn write_outputs(
-    dir: &Path,
-    sol: &Solution,
-    label: &OutputLabel,
-    order: impl Fn(usize) -> f64,
-) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let file = |name: &str| dir.join(format!("{}{name}", label.prefix));
-    let h = sol.basis().harmonics();
-    // CSV through the csv writer: a DOF name with a comma or a quote is quoted.
-    let mut w = csv::Writer::from_path(file("harmonics.csv"))?;
-    w.write_record(["dof", "harmonic", "shaft_order", "cos", "sin"])?;
-    for (i, name) in sol.dof_names().iter().enumerate() {
-        for k in 0..=h {
-            let (c, s) = sol.cos_sin(i, k);
-            w.write_record([
-                name.clone(),
-                k.to_string(),
-                order(k).to_string(),
-                format!("{c:e}"),
-                format!("{s:e}"),
-            ])?;
-        }
-    }
-    w.flush()?;
-    let points = sol.basis().samples().max(256);
-    let period = sol.basis().period();
-    let series: Vec<Vec<f64>> = (0..sol.dof_names().len())
-        .map(|i| sol.time_series(i, points))
-        .collect();
-    let mut w = csv::Writer::from_path(file("time_series.csv"))?;
-    let mut header = vec!["t".to_string(), "theta".to_string()];
-    header.extend(sol.dof_names().iter().cloned());
-    w.write_record(&header)?;
-    for j in 0..points {
-        let frac = j as f64 / points as f64;
-        let mut row = vec![
-            format!("{:e}", frac * period),
-            format!("{:e}", frac * std::f64::consts::TAU),
-        ];
-        row.extend(series.iter().map(|s| format!("{:e}", s[j])));
-        w.write_record(&row)?;
-    }
-    w.flush()?;
-    let (shown, note) = plotted_dofs(sol, h);
-    let names = sol.dof_names();
-    let lines: Vec<Series> = shown
-        .iter()
-        .map(|&i| (&names[i], &series[i]))
-        .map(|(name, s)| {
-            Series::line(
-                name.clone(),
-                s.iter()
-                    .enumerate()
-                    .map(|(j, v)| (j as f64 / points as f64 * period, *v))
-                    .collect(),
-            )
-        })
-        .collect();
-    line_plot(
-        &file("time_series.svg"),
-        &format!("{}: one period{note}", label.title),
-        &Axis::linear("t (s)"),
-        &Axis::linear("q (rad or m)"),
-        &lines,
-    )
-    .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
-    // Amplitudes below 1e-13 of the largest are rounding noise: left out.
-    let largest = shown
-        .iter()
-        .flat_map(|&i| (1..=h).map(move |k| sol.harmonic(i, k).norm()))
-        .fold(0.0f64, f64::max);
-    let spectra: Vec<Series> = shown
-        .iter()
-        .map(|&i| (i, &names[i]))
-        .map(|(i, name)| {
-            Series::markers(
-                name.clone(),
-                (1..=h)
-                    .map(|k| (k as f64, sol.harmonic(i, k).norm()))
-                    .filter(|&(_, a)| a > 1e-13 * largest)
-                    .collect(),
-            )
-        })
-        .collect();
-    if h > 0 {
-        line_plot(
-            &file("spectrum.svg"),
-            &format!(
-                "{}: amplitude spectrum (static part omitted){note}",
-                label.title
-            ),
-            &Axis::linear("harmonic k"),
-            &Axis::log("|q_k| (rad or m)"),
-            &spectra,
-        )
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
-    }
-    Ok(())
-}
-
-/// Most DOFs a plot shows (a legend of a thousand names hides the data).
-const MAX_PLOTTED_DOFS: usize = 8;
-
-/// The DOFs the plots show: all of a small model, else the [`MAX_PLOTTED_DOFS`] with the
-/// largest dynamic amplitude `Σ_{k≥1} |q̂_k|`, in model order, and a note for the title.
-fn plotted_dofs(sol: &hbal::Solution, h: usize) -> (Vec<usize>, String) {
-    let n = sol.dof_names().len();
-    if n <= MAX_PLOTTED_DOFS {
-        return ((0..n).collect(), String::new());
-    }
-    let amplitude = |i: usize| (1..=h).map(|k| sol.harmonic(i, k).norm()).sum::<f64>();
-    let mut order: Vec<(usize, f64)> = (0..n).map(|i| (i, amplitude(i))).collect();
-    order.sort_by(|a, b| b.1.total_cmp(&a.1));
-    let mut shown: Vec<usize> = order.iter().take(MAX_PLOTTED_DOFS).map(|p| p.0).collect();
-    shown.sort_unstable();
-    (
-        shown,
-        format!(" ({MAX_PLOTTED_DOFS} of {n} DOFs: the largest dynamic amplitudes)"),
-    )
 }

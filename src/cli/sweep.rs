@@ -3,9 +3,10 @@
 //! branch.csv and one frequency-response SVG per DOF. The first point starts from the linear
 //! solution or from a `--start` file.
 
-use super::{load, multipliers_json, start, Failure, SolverArgs};
+use super::sweep_summary::{point_json, secondary_json, secondary_line};
+use super::{load, start, Failure, SolverArgs};
 use anyhow::Context;
-use hbal::continuation::{Branch, BranchPoint, BranchStop, Continuation};
+use hbal::continuation::{Branch, BranchStop, Continuation};
 use hbal::HarmonicBasis;
 use num_complex::Complex64;
 use serde_json::json;
@@ -42,70 +43,6 @@ fn run(
     progress: impl FnMut(f64),
 ) -> hbal::Result<Branch> {
     continuation.run_from(model, basis, to, initial, progress)
-}
-
-/// One point of a branch as JSON; harmonic k of a branch with period multiple ν is order
-/// `k · fundamental_order / ν` of the reference shaft (`shaft_order`; `order` is kept as it
-/// was: k, or k/ν on a period-multiplied branch).
-fn point_json(
-    p: &BranchPoint,
-    branch: &Branch,
-    fundamental_order: f64,
-    speed: impl Fn(f64) -> f64,
-) -> serde_json::Value {
-    let n = branch.dofs.len();
-    let nu = branch.subharmonic.max(1);
-    let f = p.floquet.as_ref();
-    json!({
-        "speed": speed(p.omega),
-        "omega_rad_s": p.omega,
-        "stable": p.stable(),
-        "fold": p.fold,
-        "fold_speed": if p.fold { p.fold_omega.map(&speed) } else { None },
-        "spurious_turn": p.spurious_turn,
-        "bifurcation": p.bifurcation.map(|b| format!("{b:?}")),
-        "bifurcation_speed": p.bifurcation_omega.map(&speed),
-        "residual": p.residual,
-        "truncation": p.truncation,
-        "error_estimate": p.error_estimate,
-        "max_abs": p.max_abs,
-        "multipliers": f.map(multipliers_json),
-        "multipliers_abs": f.map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
-        "neutral": f.map(|f| f.neutral),
-        "orbit_correction": f.map(|f| f.orbit_correction),
-        "polished": f.map(|f| f.polished),
-        "harmonics": (0..n).map(|i| (0..=branch.harmonics).map(|k| {
-            let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
-            let shaft_order = super::element_report::order_of(k, fundamental_order, nu);
-            if nu == 1 {
-                json!({"order": k, "harmonic": k, "shaft_order": shaft_order, "cos": c, "sin": s})
-            } else {
-                json!({"harmonic": k, "order": k as f64 / nu as f64, "shaft_order": shaft_order, "cos": c, "sin": s})
-            }
-        }).collect::<Vec<_>>()).collect::<Vec<_>>(),
-    })
-}
-
-/// A secondary branch as JSON: where it leaves the main branch, its period multiple, its
-/// points and why it ended.
-fn secondary_json(
-    b: &Branch,
-    fundamental_order: f64,
-    speed: impl Fn(f64) -> f64 + Copy,
-) -> serde_json::Value {
-    let origin = b.origin.as_ref();
-    json!({
-        "bifurcation": origin.map(|o| format!("{:?}", o.bifurcation)),
-        "from_speed": origin.map(|o| speed(o.omega)),
-        "from_omega_rad_s": origin.map(|o| o.omega),
-        "side": origin.map(|o| o.side),
-        "parent_point": origin.map(|o| o.parent_point),
-        "period_multiple": b.subharmonic,
-        "stop": b.stop.to_string(),
-        "reached": b.stop.is_normal_end(),
-        "folds": b.folds(),
-        "points": b.points.iter().map(|p| point_json(p, b, fundamental_order, speed)).collect::<Vec<_>>(),
-    })
 }
 
 pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
@@ -437,51 +374,4 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     } else {
         1
     })
-}
-
-/// One line on a secondary branch: where it leaves, its period, its points and end.
-fn secondary_line(b: &Branch, unit: &str, speed: impl Fn(f64) -> f64) -> String {
-    let (what, at, side) = match &b.origin {
-        Some(o) => (
-            match o.bifurcation {
-                hbal::stability::Bifurcation::PeriodDoubling => "period-doubled branch",
-                _ => "branch",
-            },
-            format!("{:.7} {unit}", speed(o.omega)),
-            match o.side {
-                1 => " (side +)",
-                -1 => " (side -)",
-                _ => "",
-            },
-        ),
-        None => ("branch", String::from("?"), ""),
-    };
-    let unstable = b
-        .points
-        .iter()
-        .filter(|p| p.stable() == Some(false))
-        .count();
-    let end = b.points.last().map_or(String::new(), |p| {
-        format!(", ends at {:.7} {unit}", speed(p.omega))
-    });
-    let folds = match b.folds() {
-        0 => String::new(),
-        1 => ", 1 fold".to_string(),
-        f => format!(", {f} folds"),
-    };
-    format!(
-        "{what}{side} from the {} at {at}{}: {} points{end}{folds}, {} unstable: {}",
-        match b.origin.as_ref().map(|o| o.bifurcation) {
-            Some(hbal::stability::Bifurcation::PeriodDoubling) => "period doubling",
-            _ => "branch point",
-        },
-        if b.subharmonic > 1 {
-            format!(", period {}T", b.subharmonic)
-        } else {
-            String::new()
-        },
-        b.points.len(),
-        unstable,
-        b.stop
-    )
 }
