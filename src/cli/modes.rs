@@ -211,7 +211,7 @@ fn write_outputs(
         let f = |s: f64| o * s * per_unit / TAU;
         series.push(
             Series::line(format!("order {o}"), vec![(from, f(from)), (to, f(to))])
-                .with_color(3 + k % 3),
+                .with_color(3 + k % 7),
         );
     }
     let crossings: Vec<(f64, f64)> = orders

@@ -107,14 +107,19 @@ impl Axis {
     }
 }
 
-/// The palette: series `i` is drawn in `COLORS[i % 6]`.
-pub(super) const COLORS: [plotters::style::RGBColor; 6] = [
+/// The palette (black, then the "tab10" colours): series `i` is drawn in
+/// `COLORS[i % COLORS.len()]`.
+pub(super) const COLORS: [plotters::style::RGBColor; 10] = [
     plotters::style::RGBColor(0, 0, 0),
     plotters::style::RGBColor(214, 39, 40),
     plotters::style::RGBColor(31, 119, 180),
     plotters::style::RGBColor(44, 160, 44),
     plotters::style::RGBColor(148, 103, 189),
     plotters::style::RGBColor(255, 127, 14),
+    plotters::style::RGBColor(140, 86, 75),
+    plotters::style::RGBColor(227, 119, 194),
+    plotters::style::RGBColor(188, 189, 34),
+    plotters::style::RGBColor(23, 190, 207),
 ];
 
 /// Most legend rows; further series are summed up in one line.
