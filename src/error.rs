@@ -72,7 +72,7 @@ pub enum Error {
         samples: usize,
     },
     /// A load has an order above the number of harmonics.
-    #[error("load on DOF `{dof}` has order {order} but only {harmonics} harmonics are kept: raise H to at least {order}")]
+    #[error("load on DOF `{dof}` has order {order} but only {harmonics} harmonics are kept: {}", load_order_advice(*.order))]
     LoadOrderTooHigh {
         /// DOF of the load.
         dof: String,
@@ -115,6 +115,18 @@ pub enum Error {
         reference: String,
         /// The loaded DOFs of the mode with their mean loads.
         loaded: String,
+    },
+    /// A problem too large for memory (or time), refused before anything is allocated.
+    #[error("{what} needs about {size}, more than the limit of {limit}: {advice}")]
+    TooLarge {
+        /// What would be built, with the sizes that decide it.
+        what: String,
+        /// Its estimated size.
+        size: String,
+        /// The limit.
+        limit: String,
+        /// What to lower.
+        advice: String,
     },
     /// A computation produced NaN or infinity.
     #[error("non-finite value in {what}")]
@@ -197,6 +209,19 @@ fn order_advice(order: usize) -> String {
             "that is more than any harmonic basis holds (H <= {}): check the element's `teeth` \
              (mesh cycles per period of the fundamental), or make the mesh order the fundamental \
              (`fundamental.order`)",
+            crate::HarmonicBasis::MAX_HARMONICS
+        )
+    }
+}
+
+/// What to do about a load order above H: raise H, or, beyond any basis, check the order.
+fn load_order_advice(order: usize) -> String {
+    if order <= crate::HarmonicBasis::MAX_HARMONICS {
+        format!("raise H to at least {order}")
+    } else {
+        format!(
+            "that is more than any harmonic basis holds (H <= {}): check the load's `order` \
+             (a harmonic index of the fundamental)",
             crate::HarmonicBasis::MAX_HARMONICS
         )
     }

@@ -161,6 +161,11 @@ impl ModelBuilder {
                 reason: "the model has no DOFs".into(),
             });
         }
+        if n > Model::MAX_DOFS {
+            return Err(Error::InvalidDofs {
+                reason: format!("{n} DOFs, more than the limit of {}", Model::MAX_DOFS),
+            });
+        }
         let mut by_name = std::collections::HashMap::with_capacity(n);
         for (i, d) in self.dofs.iter().enumerate() {
             if d.trim().is_empty() {

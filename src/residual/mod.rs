@@ -16,8 +16,10 @@ use crate::linear::Formulation;
 use crate::model::Model;
 
 mod condensed;
+mod limits;
 mod memory;
 use crate::solution::SolveStats;
+pub use limits::{estimate_bytes, MAX_SYSTEM_BYTES};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
@@ -156,11 +158,12 @@ impl<'m> HarmonicBalance<'m> {
                 samples: basis.samples(),
             });
         }
+        limits::check_size(model, &basis, formulation)?;
         let mut f_ext = vec![Complex64::default(); (h + 1) * n];
         let nu = basis.subharmonic();
         for l in model.loads() {
             // Order k of the shaft is harmonic νk of the fundamental Ω/ν.
-            if l.order * nu > h {
+            if l.order.saturating_mul(nu) > h {
                 return Err(Error::LoadOrderTooHigh {
                     dof: model.dof_names()[l.dof].clone(),
                     order: l.order,
@@ -172,7 +175,7 @@ impl<'m> HarmonicBalance<'m> {
         // H = 0 is a static analysis by choice; otherwise every time variation must fit.
         for e in model.elements().iter().filter(|_| h > 0) {
             if let Some(order) = e.law().time_order() {
-                if order * nu > h {
+                if order.saturating_mul(nu) > h {
                     return Err(Error::ElementOrderTooHigh {
                         element: e.name().to_string(),
                         order,

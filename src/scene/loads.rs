@@ -28,6 +28,8 @@ pub(super) fn engine_error(e: crate::Error) -> (String, String) {
         crate::Error::InvalidParameter { name, .. } => {
             fail(&format!("engine.{name}"), e.to_string())
         }
+        // The path already says `engine`.
+        crate::Error::InvalidElement { reason, .. } => fail("engine", reason.clone()),
         _ => fail("engine", e.to_string()),
     }
 }

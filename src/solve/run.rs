@@ -29,10 +29,13 @@ pub struct Progress {
 
 impl Progress {
     pub(crate) fn new(x0: Vec<f64>, max_iterations: usize) -> Self {
+        // Room for the usual solve, so that iterating does not allocate; a larger (or absurd)
+        // iteration limit grows the history as needed instead of reserving it all.
+        let capacity = max_iterations.min(PREALLOCATED_ITERATIONS) + 2;
         Self {
             x: x0,
-            history: Vec::with_capacity(max_iterations + 2),
-            seconds: Vec::with_capacity(max_iterations + 2),
+            history: Vec::with_capacity(capacity),
+            seconds: Vec::with_capacity(capacity),
             termination: None,
             start: Some(Instant::now()),
         }
@@ -51,6 +54,9 @@ impl Progress {
         state.terminate_with(TerminationReason::SolverExit(String::new()))
     }
 }
+
+/// Iterations whose history is reserved before a solve starts.
+const PREALLOCATED_ITERATIONS: usize = 1 << 16;
 
 /// A solver that exposes its [`Progress`].
 pub trait HbSolver {
