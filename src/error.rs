@@ -173,6 +173,20 @@ impl Error {
     }
 }
 
+/// Smallest magnitude of a nonzero number in a scene (and of a speed): smaller ones are
+/// subnormal or round to zero in products (`1e-320` rad/s would make the period infinite).
+pub const MIN_MAGNITUDE: f64 = 1e-100;
+
+/// Largest magnitude of a number in a scene (and of a speed): a product of three such numbers
+/// is still finite (`1e308` as a mass overflows the dynamic stiffness).
+pub const MAX_MAGNITUDE: f64 = 1e100;
+
+/// `true` if `value` is 0 or finite with a magnitude in
+/// [[`MIN_MAGNITUDE`], [`MAX_MAGNITUDE`]].
+pub fn in_magnitude_range(value: f64) -> bool {
+    value == 0.0 || (MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&value.abs())
+}
+
 /// Checks that `value` is finite and `>= 0`.
 pub(crate) fn check_non_negative(context: &str, name: &str, value: f64) -> Result<()> {
     if value.is_finite() && value >= 0.0 {

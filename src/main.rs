@@ -62,10 +62,10 @@ enum Command {
         /// Scene file (.toml or .json).
         scene: PathBuf,
         /// Start speed (the scene's unit; default: the --start file's speed, else the scene's).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         from: Option<f64>,
         /// End speed (the scene's unit).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         to: f64,
         #[command(flatten)]
         solver: cli::SolverArgs,
@@ -94,7 +94,7 @@ enum Command {
         #[arg(long)]
         all_branches: bool,
         /// Largest continuation step (scaled arclength; smaller gives more points).
-        #[arg(long, default_value_t = 0.5)]
+        #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
         max_step: f64,
         /// Sweep this numeric scene field instead of the speed, e.g. `elements[0].alpha` or
         /// `loads[1].cos` (a warm-started sweep that does not follow folds).
@@ -118,7 +118,7 @@ enum Command {
         #[arg(long, allow_negative_numbers = true)]
         to: Option<f64>,
         /// Modes up to this frequency in Hz (default: every mode up to 300 DOFs, else 5000).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         max_hz: Option<f64>,
         #[command(flatten)]
         solver: cli::SolverArgs,

@@ -61,6 +61,7 @@ pub(crate) fn parameter_sweep(
     let values: Vec<f64> = (0..points)
         .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
         .collect();
+    whole_values(&doc, name, &values, &file)?;
     let bar = indicatif::ProgressBar::new(points as u64);
     if as_json {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
@@ -155,4 +156,29 @@ pub(crate) fn parameter_sweep(
     } else {
         1
     })
+}
+
+/// A whole-number field (`harmonics.count`, a `teeth`) takes whole values only: refuses the
+/// sweep before it starts if one of `values` is not whole and the field does not take it.
+fn whole_values(
+    doc: &serde_json::Value,
+    name: &str,
+    values: &[f64],
+    file: &str,
+) -> Result<(), Failure> {
+    let Some((i, x)) = values.iter().enumerate().find(|(_, x)| x.fract() != 0.0) else {
+        return Ok(());
+    };
+    let mut probe = doc.clone();
+    hbal::scene::set_parameter(&mut probe, name, *x)
+        .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
+    match Scene::from_value(probe, file) {
+        Err(e) if e.message.starts_with("invalid type: floating point") => Err(anyhow::anyhow!(
+            "{file}: --parameter {name} takes whole numbers, and value {} ({x}) is not one: \
+             choose --from, --to and --points so that every value is whole",
+            i + 1
+        )
+        .into()),
+        _ => Ok(()),
+    }
 }

@@ -21,8 +21,8 @@ pub(crate) fn check_teeth(context: &str, teeth: u32) -> Result<()> {
             "teeth",
             teeth as f64,
             format!(
-                "an integer in 1..={MAX_TEETH} (mesh cycles per period of the fundamental; a \
-                 higher mesh order is beyond any harmonic basis: make the mesh order the \
+                "an integer in 1..={MAX_TEETH}: mesh cycles per period of the fundamental, \
+                 and more is more than any harmonic basis holds (make the mesh order the \
                  fundamental with `fundamental.order`)"
             ),
         ))
@@ -257,7 +257,19 @@ impl MeshProfile {
             }
             MeshProfile::Cosine { mean, amplitude } => {
                 check_non_negative(context, "mean", *mean)?;
-                check_finite(context, "amplitude", *amplitude)
+                check_finite(context, "amplitude", *amplitude)?;
+                if amplitude.abs() > *mean {
+                    return Err(Error::invalid(
+                        context,
+                        "amplitude",
+                        *amplitude,
+                        format!(
+                            "at most the mean {mean} in magnitude (the stiffness falls to mean - \
+                             |amplitude|, and a mesh stiffness must not be negative)"
+                        ),
+                    ));
+                }
+                Ok(())
             }
             MeshProfile::Fourier { mean, cos, sin } => {
                 check_non_negative(context, "mean", *mean)?;
@@ -267,10 +279,53 @@ impl MeshProfile {
                 for (j, s) in sin.iter().enumerate() {
                     check_finite(context, &format!("sin[{j}]"), *s)?;
                 }
+                let orders = cos.len().max(sin.len());
+                if orders > MAX_TEETH as usize {
+                    return Err(Error::InvalidElement {
+                        context: context.into(),
+                        reason: format!(
+                            "the Fourier profile has {orders} orders, more than any harmonic \
+                             basis resolves ({MAX_TEETH})"
+                        ),
+                    });
+                }
+                let (lowest, phi) = self.fourier_minimum(orders);
+                let scale = mean + cos.iter().chain(sin).map(|c| c.abs()).sum::<f64>();
+                if lowest < -1e-9 * scale {
+                    return Err(Error::InvalidElement {
+                        context: context.into(),
+                        reason: format!(
+                            "the Fourier stiffness profile falls to {lowest:.6e} at φ = {phi:.4} \
+                             rad: a mesh stiffness must not be negative (raise `mean` or lower \
+                             the coefficients)"
+                        ),
+                    });
+                }
                 Ok(())
             }
             MeshProfile::Sampled(_) => Ok(()),
         }
+    }
+
+    /// The lowest value of a Fourier profile with `orders` orders on a grid of at least 16
+    /// points per period of its highest order (one inverse FFT), and its angle.
+    fn fourier_minimum(&self, orders: usize) -> (f64, f64) {
+        if orders == 0 {
+            return (self.mean(), 0.0);
+        }
+        let samples = (16 * orders).next_power_of_two();
+        let table = SampledProfile::new(self, orders, 1, 0.0, samples);
+        let (i, lowest) =
+            table
+                .values
+                .iter()
+                .copied()
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |a, (i, v)| if v < a.1 { (i, v) } else { a },
+                );
+        (lowest, TAU * i as f64 / samples as f64)
     }
 
     /// The profile a harmonic basis with `samples` shaft angles per revolution should evaluate

@@ -130,6 +130,17 @@ pub(super) fn read(value: &Value, base: &Path) -> Result<Dofs, (String, String)>
                 };
                 (path, x.into_inner().to_string())
             })?;
+            let mut first = std::collections::HashMap::new();
+            for (i, name) in names.iter().enumerate() {
+                if let Some(j) = first.insert(name.as_str(), i) {
+                    return Err(e(
+                        &format!("dofs[{i}]"),
+                        format!(
+                            "DOF `{name}` appears twice (first at dofs[{j}]): names are unique"
+                        ),
+                    ));
+                }
+            }
             Dofs {
                 names,
                 origin: None,

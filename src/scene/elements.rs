@@ -58,6 +58,12 @@ pub(super) fn add(
                 ))
             }
         };
+        if connects.values().all(|w| *w == 0.0) {
+            return Err(fail(
+                &at("connects"),
+                "needs a DOF with a nonzero weight (the coordinate is u = Σ w q)".into(),
+            ));
+        }
         for dof in connects.keys() {
             if !known.contains(dof.as_str()) {
                 return Err(fail(

@@ -71,6 +71,16 @@ pub(super) fn add(
                 ),
             ));
         }
+        if l.order == 0 && l.sin != 0.0 {
+            return Err(fail(
+                &format!("loads[{i}].sin"),
+                format!(
+                    "must be 0 on a static load (order 0, where sin(0 Ωt) = 0), got {}: give \
+                     the static load in `cos`",
+                    l.sin
+                ),
+            ));
+        }
         builder = builder.load(&l.dof, l.order, l.cos, l.sin);
     }
     Ok(builder)
