@@ -8,7 +8,9 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 ///
 /// Problems with the iteration itself (divergence, running out of iterations, a non-finite
 /// iterate) are not errors: they are a [`Termination`](crate::Termination) of the returned
-/// [`Solution`](crate::Solution), which keeps the last good iterate.
+/// [`Solution`](crate::Solution), which keeps the last good iterate. Only where there is no
+/// finite iterate at all (the start itself has no finite residual) a solve returns
+/// [`Error::NonFinite`], naming where: no result ever holds NaN or infinity.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
     /// A parameter is non-finite or outside its physical range.

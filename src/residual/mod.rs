@@ -17,6 +17,7 @@ use crate::model::Model;
 
 mod condensed;
 mod limits;
+mod located;
 mod memory;
 use crate::solution::SolveStats;
 pub use limits::{estimate_bytes, MAX_SYSTEM_BYTES};
@@ -417,11 +418,7 @@ impl<'m> HarmonicBalance<'m> {
                 ws.f[j] = mean - lin.offset - lin.stiffness * u - lin.damping * du;
             }
             ws.force_evaluations += self.basis.samples() + 2 * act.jump_samples.len();
-            if !ws.f.iter().all(|v| v.is_finite()) {
-                return Err(Error::NonFinite {
-                    what: format!("force of element `{}`", e.name()),
-                });
-            }
+            self.samples(ws).check("force", e.name(), &ws.f)?;
             // Contact edges crossed between samples: the trapezoid error, from the local
             // harmonics still in `uk` (see [`crate::harmonic::kinks`]).
             ws.crossings.clear();
@@ -454,11 +451,9 @@ impl<'m> HarmonicBalance<'m> {
                     *g -= lin.stiffness;
                     *d -= lin.damping;
                 }
-                if !ws.gu.iter().chain(&ws.gdu).all(|v| v.is_finite()) {
-                    return Err(Error::NonFinite {
-                        what: format!("force derivatives of element `{}`", e.name()),
-                    });
-                }
+                let samples = self.samples(ws);
+                samples.check("force derivative ∂f/∂u", e.name(), &ws.gu)?;
+                samples.check("force derivative ∂f/∂u̇", e.name(), &ws.gdu)?;
                 self.aft
                     .spectrum_into(&mut ws.gu, &mut ws.spec_u, &mut ws.aft);
                 self.aft
@@ -533,11 +528,7 @@ impl<'m> HarmonicBalance<'m> {
                     *f = (g - d0) * du / omega;
                 }
             }
-            if !b.f.iter().all(|v| v.is_finite()) {
-                return Err(Error::NonFinite {
-                    what: format!("Ω-derivative of element `{}`", e.name()),
-                });
-            }
+            self.samples(b).check("Ω-derivative", e.name(), &b.f)?;
             self.aft.analyze_into(&mut b.f, &mut b.uk, &mut b.aft);
             b.ffts += 3;
             for k in 0..=h {
