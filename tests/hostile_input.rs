@@ -17,8 +17,13 @@ fn example(name: &str) -> String {
     std::fs::read_to_string(p).expect("example scene")
 }
 
+/// A directory of this test's own (tests run in parallel threads named after them).
 fn temp_dir() -> PathBuf {
-    std::env::temp_dir().join(format!("hbal-hostile-input-{}", std::process::id()))
+    let test = std::thread::current()
+        .name()
+        .unwrap_or("main")
+        .replace("::", "-");
+    std::env::temp_dir().join(format!("hbal-hostile-input-{}-{test}", std::process::id()))
 }
 
 /// `example` with `from` replaced by `to` (which must change it).
@@ -382,4 +387,60 @@ fn library_non_finite_errors_name_the_place() {
         err.contains("parameter `omega` must be finite and in [1e-100, 1e100] rad/s"),
         "{err}"
     );
+}
+
+/// A parameter sweep that meets an undamped resonance keeps its points and exits 1; an
+/// unusable `--out` is refused before the sweep (exit 2); a DOF name with `/` stays inside
+/// `--out`.
+#[test]
+fn parameter_sweep_failures_are_honest() {
+    let undamped = "dofs = [\"x/1\"]\nmass = [[1.0]]\nstiffness = [[1.0]]\n\
+                    fundamental = { rad_s = 0.6 }\nharmonics = { count = 3 }\n\
+                    loads = [{ dof = \"x/1\", order = 1, cos = 0.1 }]\n[[elements]]\n\
+                    name = \"s\"\ntype = \"cubic_spring\"\nconnects = { \"x/1\" = 1.0 }\n\
+                    k = 0.0\nalpha = 0.1\n";
+    let dir = temp_dir();
+    let out = dir.join("out");
+    let out = out.to_str().expect("utf-8");
+    let sweep = [
+        "sweep",
+        "{}",
+        "--parameter",
+        "fundamental.rad_s",
+        "--from",
+        "0.6",
+        "--to",
+        "1.5",
+        "--points",
+        "10",
+        "--no-stability",
+        "--out",
+        out,
+    ];
+    let run = expect(
+        "undamped.toml",
+        undamped,
+        &sweep,
+        1,
+        "failed at parameter 1: dynamic stiffness is singular at harmonic 1",
+    );
+    assert!(
+        run.stdout.contains("4 values of fundamental.rad_s"),
+        "{}",
+        run.stdout
+    );
+    assert!(dir.join("out/parameter_response_x_1.svg").is_file());
+    let blocked = dir.join("undamped.toml");
+    let blocked = format!("{}/sub", blocked.display());
+    let mut args = sweep;
+    args[12] = &blocked;
+    let run = expect(
+        "undamped.toml",
+        undamped,
+        &args,
+        2,
+        "--out: cannot write to",
+    );
+    assert!(run.stdout.is_empty(), "{}", run.stdout);
+    let _ = std::fs::remove_dir_all(temp_dir());
 }

@@ -9,8 +9,9 @@
 //! list entry dropped, a list
 //! entry duplicated, or a string replaced. The default is a short run (8 cases, a few seconds);
 //! `PROPTEST_CASES=N` sets the number of cases, and
-//! `PROPTEST_CASES=100000 cargo test --release --test hostile_property -- --nocapture` is the
-//! long run (the summary line reports the cases, runs, exit codes and breaches).
+//! `HOSTILE_SECONDS=600 PROPTEST_CASES=1000000 cargo test --release --test hostile_property --
+//! --nocapture` is the long run: ten minutes (cases after the time budget are skipped), and the
+//! summary line reports the cases, runs, exit codes and breaches.
 
 #[path = "common/hostile.rs"]
 mod hostile;
@@ -235,8 +236,17 @@ fn mutated_scenes_keep_the_exit_code_contract() {
         prop::collection::vec(mutation(), 1..=4),
         methods,
     );
+    // A time budget for the long run: later cases are skipped.
+    let budget = std::env::var("HOSTILE_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .map(std::time::Duration::from_secs_f64);
+    let started = std::time::Instant::now();
     let tally = Mutex::new(Tally::default());
     let result = runner.run(&strategy, |(index, mutations, method)| {
+        if budget.is_some_and(|b| started.elapsed() > b) {
+            return Ok(());
+        }
         let (path, doc) = &scenes[index];
         let mut doc = doc.clone();
         for m in &mutations {
@@ -290,10 +300,11 @@ fn mutated_scenes_keep_the_exit_code_contract() {
     let t = tally.into_inner().expect("tally");
     let count = |b: Breach| t.breaches.get(&format!("{b:?}")).copied().unwrap_or(0);
     eprintln!(
-        "hostile_property: {} cases, {} runs of hbal, exit codes {:?}, panics {}, aborts {}, \
+        "hostile_property: {} cases in {:.0} s, {} runs of hbal, exit codes {:?}, panics {}, aborts {}, \
          timeouts {}, non-finite outputs {}, inconsistent exit codes {}, slowest run {:.2} s \
          ({})",
         t.cases,
+        started.elapsed().as_secs_f64(),
         t.runs,
         t.codes,
         count(Breach::Panic),

@@ -43,7 +43,20 @@ pub fn parameter_sweep(
                 None => return Err(e),
             },
         };
-        let mut hb = HarmonicBalance::with_formulation(&model, basis, formulation)?;
+        let mut hb = match HarmonicBalance::with_formulation(&model, basis, formulation) {
+            Ok(hb) => hb,
+            // After the first point, a numerical failure ends the branch and keeps its points.
+            Err(e) => match branch.as_mut() {
+                Some(b) => {
+                    b.stop = BranchStop::Failed {
+                        parameter: p,
+                        reason: e.to_string(),
+                    };
+                    break;
+                }
+                None => return Err(e),
+            },
+        };
         crate::solve::check_dense_for_continuation(&hb)?;
         let mut ws = hb.workspace();
         let full = (basis.harmonics() + 1) * model.n_dofs();

@@ -160,10 +160,15 @@ impl GearStage {
     /// Mesh cycles per period of the fundamental, `z1 · shaft_order / f`, if it is a whole
     /// number >= 1 (to 1e-9).
     pub fn mesh_order(&self) -> Option<u32> {
-        let z = self.teeth as f64 * self.shaft_order / self.fundamental_order;
+        let z = self.mesh_cycles();
         let r = z.round();
         (z.is_finite() && r >= 1.0 && r <= u32::MAX as f64 && (z - r).abs() <= 1e-9 * z.max(1.0))
             .then_some(r as u32)
+    }
+
+    /// Mesh cycles per period of the fundamental, `z1 · shaft_order / f`, as a real number.
+    fn mesh_cycles(&self) -> f64 {
+        self.teeth as f64 * self.shaft_order / self.fundamental_order
     }
 
     /// Checks every field; `context` names the element.
@@ -190,7 +195,7 @@ impl GearStage {
         crate::force::check_teeth(context, self.teeth)?;
         check_positive(context, "shaft_order", self.shaft_order)?;
         check_positive(context, "fundamental_order", self.fundamental_order)?;
-        let z = self.teeth as f64 * self.shaft_order / self.fundamental_order;
+        let z = self.mesh_cycles();
         if z > MAX_TEETH as f64 + 0.5 {
             return Err(Error::invalid(
                 context,
