@@ -277,10 +277,8 @@ fn meaningless_fields_are_refused_with_their_path() {
         "--to must be a finite speed > 0 (rad_s), got -1",
     );
     // A whole-number field takes whole values ...
-    let run = expect(
-        "duffing.toml",
-        &duffing,
-        &[
+    let count_sweep = |points| {
+        [
             "sweep",
             "{}",
             "--parameter",
@@ -290,11 +288,10 @@ fn meaningless_fields_are_refused_with_their_path() {
             "--to",
             "9",
             "--points",
-            "5",
-        ],
-        0,
-        "",
-    );
+            points,
+        ]
+    };
+    let run = expect("duffing.toml", &duffing, &count_sweep("5"), 0, "");
     assert!(
         run.stdout
             .contains("5 values of harmonics.count from 5 to 9"),
@@ -305,18 +302,7 @@ fn meaningless_fields_are_refused_with_their_path() {
     expect(
         "duffing.toml",
         &duffing,
-        &[
-            "sweep",
-            "{}",
-            "--parameter",
-            "harmonics.count",
-            "--from",
-            "5",
-            "--to",
-            "9",
-            "--points",
-            "4",
-        ],
+        &count_sweep("4"),
         2,
         "--parameter harmonics.count takes whole numbers, and value 2 (6.333333333333333) is not \
          one: choose --from, --to and --points so that every value is whole",
