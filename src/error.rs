@@ -8,7 +8,9 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 ///
 /// Problems with the iteration itself (divergence, running out of iterations, a non-finite
 /// iterate) are not errors: they are a [`Termination`](crate::Termination) of the returned
-/// [`Solution`](crate::Solution), which keeps the last good iterate.
+/// [`Solution`](crate::Solution), which keeps the last good iterate. Only where there is no
+/// finite iterate at all (the start itself has no finite residual) a solve returns
+/// [`Error::NonFinite`], naming where: no result ever holds NaN or infinity.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
     /// A parameter is non-finite or outside its physical range.
@@ -72,7 +74,7 @@ pub enum Error {
         samples: usize,
     },
     /// A load has an order above the number of harmonics.
-    #[error("load on DOF `{dof}` has order {order} but only {harmonics} harmonics are kept: raise H to at least {order}")]
+    #[error("load on DOF `{dof}` has order {order} but only {harmonics} harmonics are kept: {}", load_order_advice(*.order))]
     LoadOrderTooHigh {
         /// DOF of the load.
         dof: String,
@@ -115,6 +117,18 @@ pub enum Error {
         reference: String,
         /// The loaded DOFs of the mode with their mean loads.
         loaded: String,
+    },
+    /// A problem too large for memory (or time), refused before anything is allocated.
+    #[error("{what} needs about {size}, more than the limit of {limit}: {advice}")]
+    TooLarge {
+        /// What would be built, with the sizes that decide it.
+        what: String,
+        /// Its estimated size.
+        size: String,
+        /// The limit.
+        limit: String,
+        /// What to lower.
+        advice: String,
     },
     /// A computation produced NaN or infinity.
     #[error("non-finite value in {what}")]
@@ -161,6 +175,20 @@ impl Error {
     }
 }
 
+/// Smallest magnitude of a nonzero number in a scene (and of a speed): smaller ones are
+/// subnormal or round to zero in products (`1e-320` rad/s would make the period infinite).
+pub const MIN_MAGNITUDE: f64 = 1e-100;
+
+/// Largest magnitude of a number in a scene (and of a speed): a product of three such numbers
+/// is still finite (`1e308` as a mass overflows the dynamic stiffness).
+pub const MAX_MAGNITUDE: f64 = 1e100;
+
+/// `true` if `value` is 0 or finite with a magnitude in
+/// [[`MIN_MAGNITUDE`], [`MAX_MAGNITUDE`]].
+pub fn in_magnitude_range(value: f64) -> bool {
+    value == 0.0 || (MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&value.abs())
+}
+
 /// Checks that `value` is finite and `>= 0`.
 pub(crate) fn check_non_negative(context: &str, name: &str, value: f64) -> Result<()> {
     if value.is_finite() && value >= 0.0 {
@@ -197,6 +225,19 @@ fn order_advice(order: usize) -> String {
             "that is more than any harmonic basis holds (H <= {}): check the element's `teeth` \
              (mesh cycles per period of the fundamental), or make the mesh order the fundamental \
              (`fundamental.order`)",
+            crate::HarmonicBasis::MAX_HARMONICS
+        )
+    }
+}
+
+/// What to do about a load order above H: raise H, or, beyond any basis, check the order.
+fn load_order_advice(order: usize) -> String {
+    if order <= crate::HarmonicBasis::MAX_HARMONICS {
+        format!("raise H to at least {order}")
+    } else {
+        format!(
+            "that is more than any harmonic basis holds (H <= {}): check the load's `order` \
+             (a harmonic index of the fundamental)",
             crate::HarmonicBasis::MAX_HARMONICS
         )
     }

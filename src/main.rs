@@ -62,10 +62,10 @@ enum Command {
         /// Scene file (.toml or .json).
         scene: PathBuf,
         /// Start speed (the scene's unit; default: the --start file's speed, else the scene's).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         from: Option<f64>,
         /// End speed (the scene's unit).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         to: f64,
         #[command(flatten)]
         solver: cli::SolverArgs,
@@ -75,8 +75,9 @@ enum Command {
         /// Skip the Floquet stability of the points.
         #[arg(long)]
         no_stability: bool,
-        /// Stop after this many points (exit code 1 if --to is not reached; default 2000).
-        #[arg(long)]
+        /// Stop after this many points (exit code 1 if --to is not reached; default 2000, at
+        /// most 100000).
+        #[arg(long, value_parser = sweep_points(1))]
         max_points: Option<usize>,
         /// Print exactly one JSON object on stdout instead of the summary.
         #[arg(long)]
@@ -98,14 +99,14 @@ enum Command {
         #[arg(long)]
         all_branches: bool,
         /// Largest continuation step (scaled arclength; smaller gives more points).
-        #[arg(long, default_value_t = 0.5)]
+        #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
         max_step: f64,
         /// Sweep this numeric scene field instead of the speed, e.g. `elements[0].alpha` or
         /// `loads[1].cos` (a warm-started sweep that does not follow folds).
         #[arg(long)]
         parameter: Option<String>,
-        /// Number of values of a --parameter sweep.
-        #[arg(long, default_value_t = 101)]
+        /// Number of values of a --parameter sweep (2 to 100000).
+        #[arg(long, default_value_t = 101, value_parser = sweep_points(2))]
         points: usize,
     },
     /// Natural frequencies and mode shapes about the scene's periodic solution (with the
@@ -122,7 +123,7 @@ enum Command {
         #[arg(long, allow_negative_numbers = true)]
         to: Option<f64>,
         /// Modes up to this frequency in Hz (default: every mode up to 300 DOFs, else 5000).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         max_hz: Option<f64>,
         #[command(flatten)]
         solver: cli::SolverArgs,
@@ -165,6 +166,14 @@ enum Command {
         /// Scene file (.toml or .json).
         scene: PathBuf,
     },
+}
+
+/// Largest number of points of a sweep (`--max-points`, `--points`): bounds its time.
+const MAX_SWEEP_POINTS: u64 = 100_000;
+
+/// A point count from `min` to [`MAX_SWEEP_POINTS`].
+fn sweep_points(min: u64) -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::new().range(min..=MAX_SWEEP_POINTS)
 }
 
 fn main() -> ExitCode {

@@ -31,6 +31,19 @@ pub enum Termination {
     Interrupted,
 }
 
+impl Termination {
+    /// The termination for an error met while iterating: a non-finite value names where
+    /// (the error's own `what`, not its message, which would say "non-finite value in" twice).
+    pub fn from_error(e: &crate::Error) -> Self {
+        Termination::NonFinite {
+            what: match e {
+                crate::Error::NonFinite { what } => what.clone(),
+                other => other.to_string(),
+            },
+        }
+    }
+}
+
 impl std::fmt::Display for Termination {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

@@ -111,7 +111,7 @@ fn model_errors_name_the_place() {
                     ),
                 )
                 .build(),
-            "parameter `teeth` must be an integer >= 1",
+            "parameter `teeth` must be an integer in 1..=65536",
         ),
         (
             Model::builder(&["a"])
@@ -182,7 +182,7 @@ fn new_law_errors_name_element_and_field() {
         ),
         (
             Box::new(GapContact::new(0.0, 1.0).with_teeth(0)),
-            "element `el`: parameter `teeth` must be an integer >= 1",
+            "element `el`: parameter `teeth` must be an integer in 1..=65536",
         ),
         (
             Box::new(StopSpring::new(vec![])),

@@ -240,7 +240,7 @@ fn bad_gear_stages_name_the_element_and_field() {
             "elements[0].shaft_order",
             "whole multiple",
         ),
-        ("teeth = 2", "teeth = 0", "elements[0].teeth", ">= 1"),
+        ("teeth = 2", "teeth = 0", "elements[0].teeth", "1..=65536"),
         (
             "teeth = 2",
             "teeth = 2\nbacklash = -1e-4",

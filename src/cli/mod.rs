@@ -76,8 +76,8 @@ pub(crate) struct SolverArgs {
     /// default for --harmonics).
     #[arg(long)]
     pub(crate) samples: Option<usize>,
-    /// Relative residual tolerance of the solver, in [0, 1) (default: the scene's).
-    #[arg(long)]
+    /// Relative residual tolerance of the solver, in [1e-15, 1) (default: the scene's).
+    #[arg(long, allow_negative_numbers = true)]
     pub(crate) tolerance: Option<f64>,
     /// Unknowns: `full` (all DOFs per harmonic), `condensed` (the element coordinates,
     /// exact; for large models), or `auto` (condensed where it pays).
@@ -116,6 +116,7 @@ impl SolverArgs {
             return Ok(method);
         };
         let context = || format!("{file}: --tolerance");
+        hbal::scene::check_tolerance(t).map_err(|m| anyhow::anyhow!("{}: {m}", context()))?;
         Ok(match method {
             Method::FixedPoint(o) => Method::FixedPoint(o.with_tolerance(t).with_context(context)?),
             Method::Newton(o) => Method::Newton(o.with_tolerance(t).with_context(context)?),

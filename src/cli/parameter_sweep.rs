@@ -67,6 +67,11 @@ pub(crate) fn parameter_sweep(
     let values: Vec<f64> = (0..points)
         .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
         .collect();
+    whole_values(&doc, name, &values, &file)?;
+    // An unusable --out is bad input, found before the work.
+    if let Some(dir) = out {
+        writable(dir)?;
+    }
     let bar = indicatif::ProgressBar::new(points as u64);
     if as_json {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
@@ -145,7 +150,7 @@ pub(crate) fn parameter_sweep(
         if branch.points.len() >= 2 {
             for (i, dof) in branch.dofs.iter().enumerate() {
                 hbal::report::branch_plot(
-                    &dir.join(format!("parameter_response_{dof}.svg")),
+                    &dir.join(format!("parameter_response_{}.svg", file_part(dof))),
                     &branch,
                     i,
                     &format!("Response of {dof} against {name}"),
@@ -156,9 +161,59 @@ pub(crate) fn parameter_sweep(
             }
         }
     }
-    Ok(if branch.stop == BranchStop::Reached {
-        0
+    if branch.stop == BranchStop::Reached {
+        Ok(0)
     } else {
-        1
-    })
+        eprintln!("error: {file}: the sweep stopped: {}", branch.stop);
+        Ok(1)
+    }
+}
+
+/// A whole-number field (`harmonics.count`, a `teeth`) takes whole values only: refuses the
+/// sweep before it starts if one of `values` is not whole and the field does not take it.
+fn whole_values(
+    doc: &serde_json::Value,
+    name: &str,
+    values: &[f64],
+    file: &str,
+) -> Result<(), Failure> {
+    let Some((i, x)) = values.iter().enumerate().find(|(_, x)| x.fract() != 0.0) else {
+        return Ok(());
+    };
+    let mut probe = doc.clone();
+    hbal::scene::set_parameter(&mut probe, name, *x)
+        .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
+    match Scene::from_value(probe, file) {
+        Err(e) if e.message.starts_with("invalid type: floating point") => Err(anyhow::anyhow!(
+            "{file}: --parameter {name} takes whole numbers, and value {} ({x}) is not one: \
+             choose --from, --to and --points so that every value is whole",
+            i + 1
+        )
+        .into()),
+        _ => Ok(()),
+    }
+}
+
+/// Creates `dir` and checks that a file can be written in it.
+fn writable(dir: &Path) -> Result<(), Failure> {
+    let probe = dir.join(".hbal-write-test");
+    std::fs::create_dir_all(dir)
+        .and_then(|_| std::fs::write(&probe, b""))
+        .and_then(|_| std::fs::remove_file(&probe))
+        .with_context(|| format!("--out: cannot write to {}", dir.display()))?;
+    Ok(())
+}
+
+/// A DOF name as part of a file name: characters other than letters, digits, `-`, `_`, `.`
+/// and `+` become `_` (a `/` must not lead out of `--out`).
+fn file_part(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_alphanumeric() || "-_.+".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }

@@ -111,6 +111,14 @@ pub enum BranchStop {
         /// What is wrong.
         reason: String,
     },
+    /// The harmonic-balance system could not be set up at this parameter value (an undamped
+    /// resonance on a harmonic, a system too large): the points before it are kept.
+    Failed {
+        /// The parameter value.
+        parameter: f64,
+        /// Why.
+        reason: String,
+    },
     /// The stability of a point could not be computed (the point is kept without it).
     StabilityFailed {
         /// Where.
@@ -159,6 +167,9 @@ impl std::fmt::Display for BranchStop {
             }
             BranchStop::InvalidParameter { parameter, reason } => {
                 write!(f, "invalid scene at parameter {parameter}: {reason}")
+            }
+            BranchStop::Failed { parameter, reason } => {
+                write!(f, "failed at parameter {parameter}: {reason}")
             }
             BranchStop::NotConverged { parameter } => {
                 write!(

@@ -43,14 +43,39 @@ pub fn parameter_sweep(
                 None => return Err(e),
             },
         };
-        let mut hb = HarmonicBalance::with_formulation(&model, basis, formulation)?;
+        let mut hb = match HarmonicBalance::with_formulation(&model, basis, formulation) {
+            Ok(hb) => hb,
+            // After the first point, a numerical failure ends the branch and keeps its points.
+            Err(e) => match branch.as_mut() {
+                Some(b) => {
+                    b.stop = BranchStop::Failed {
+                        parameter: p,
+                        reason: e.to_string(),
+                    };
+                    break;
+                }
+                None => return Err(e),
+            },
+        };
         crate::solve::check_dense_for_continuation(&hb)?;
         let mut ws = hb.workspace();
         let full = (basis.harmonics() + 1) * model.n_dofs();
         let sol = match &previous {
-            Some(q) if q.len() == full => Newton::new()
-                .with_tolerance(cont.tolerance)?
-                .solve_from(&hb, q, &mut ws)?,
+            Some(q) if q.len() == full => {
+                match Newton::new()
+                    .with_tolerance(cont.tolerance)?
+                    .solve_from(&hb, q, &mut ws)
+                {
+                    // No finite residual from the previous point: Newton fails here.
+                    Err(Error::NonFinite { .. }) => {
+                        if let Some(b) = branch.as_mut() {
+                            b.stop = BranchStop::NotConverged { parameter: p };
+                        }
+                        break;
+                    }
+                    r => r?,
+                }
+            }
             // The first value: the robust start (other solvers, load homotopy).
             _ => {
                 let start = robust_start(&mut hb, &cont.method, None, cont.tolerance, &mut ws)?;

@@ -2,7 +2,7 @@
 
 use super::profile::jump_angles;
 use super::{ForceLaw, LinearPart, MeshProfile};
-use crate::error::{check_finite, check_non_negative, Error, Result};
+use crate::error::{check_finite, check_non_negative, Result};
 
 /// Gear contact with backlash: `f = k(φ) g(u) + c u̇ [|u| > b]` with the dead zone
 ///
@@ -191,9 +191,7 @@ impl ForceLaw for Backlash {
     }
     fn validate(&self, context: &str) -> Result<()> {
         check_non_negative(context, "half_backlash", self.half_backlash)?;
-        if self.teeth == 0 {
-            return Err(Error::invalid(context, "teeth", 0.0, "an integer >= 1"));
-        }
+        super::profile::check_teeth(context, self.teeth)?;
         check_finite(context, "phase", self.phase)?;
         check_non_negative(context, "contact_damping", self.contact_damping)?;
         self.stiffness.validate(context)

@@ -2,7 +2,7 @@
 
 use super::profile::jump_angles;
 use super::{ForceLaw, LinearPart, MeshProfile};
-use crate::error::{check_finite, check_non_negative, Error, Result};
+use crate::error::{check_finite, check_non_negative, Result};
 
 /// One-sided (unilateral) contact with a gap:
 ///
@@ -215,9 +215,7 @@ impl ForceLaw for GapContact {
     }
     fn validate(&self, context: &str) -> Result<()> {
         check_finite(context, "gap", self.gap)?;
-        if self.teeth == 0 {
-            return Err(Error::invalid(context, "teeth", 0.0, "an integer >= 1"));
-        }
+        super::profile::check_teeth(context, self.teeth)?;
         check_finite(context, "phase", self.phase)?;
         check_non_negative(context, "contact_damping", self.contact_damping)?;
         self.stiffness.validate(context)

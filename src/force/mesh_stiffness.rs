@@ -3,7 +3,7 @@
 
 use super::profile::{cycle_fraction, jump_angles};
 use super::{ForceLaw, LinearPart, MeshDamping, MeshProfile};
-use crate::error::{check_finite, Error, Result};
+use crate::error::{check_finite, Result};
 
 /// Time-varying gear-mesh stiffness `f = k(φ) u + d(φ) u̇`, `φ = z θ + φ0`.
 ///
@@ -132,9 +132,7 @@ impl ForceLaw for MeshStiffness {
         }))
     }
     fn validate(&self, context: &str) -> Result<()> {
-        if self.teeth == 0 {
-            return Err(Error::invalid(context, "teeth", 0.0, "an integer >= 1"));
-        }
+        super::profile::check_teeth(context, self.teeth)?;
         check_finite(context, "phase", self.phase)?;
         self.profile.validate(context)?;
         self.damping.validate(context)

@@ -32,6 +32,7 @@ mod offset;
 mod polynomial_spring;
 mod profile;
 mod quadratic_damper;
+mod sampled;
 mod stop_spring;
 
 pub use backlash::{Backlash, Flank};
@@ -45,7 +46,8 @@ pub use memory::{Hysteresis, StepDerivatives, MAX_STATE};
 pub use mesh_stiffness::MeshStiffness;
 pub use offset::Offset;
 pub use polynomial_spring::PolynomialSpring;
-pub use profile::{MeshDamping, MeshProfile};
+pub(crate) use profile::check_teeth;
+pub use profile::{MeshDamping, MeshProfile, MAX_TEETH};
 pub use quadratic_damper::QuadraticDamper;
 pub use stop_spring::{Stage, StopSpring};
 

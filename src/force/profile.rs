@@ -1,9 +1,33 @@
 //! Periodic mesh-stiffness and mesh-damping profiles over the mesh angle `φ = z θ + φ0`.
 
+use super::sampled::SampledProfile;
 use crate::error::{check_finite, check_non_negative, Error, Result};
-use num_complex::Complex64;
 use std::f64::consts::TAU;
 use std::sync::Arc;
+
+/// Largest number of mesh cycles per fundamental period (`teeth` of a mesh law, the mesh order
+/// of a gear stage): [`HarmonicBasis::MAX_HARMONICS`](crate::HarmonicBasis::MAX_HARMONICS), the
+/// highest order any harmonic basis resolves. It also bounds the work of the time-domain
+/// integrators, which stop at every stiffness jump (two per mesh cycle).
+pub const MAX_TEETH: u32 = crate::HarmonicBasis::MAX_HARMONICS as u32;
+
+/// Checks a mesh law's `teeth`: an integer in `1..=MAX_TEETH`.
+pub(crate) fn check_teeth(context: &str, teeth: u32) -> Result<()> {
+    if (1..=MAX_TEETH).contains(&teeth) {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            context,
+            "teeth",
+            teeth as f64,
+            format!(
+                "an integer in 1..={MAX_TEETH}: mesh cycles per period of the fundamental, \
+                 and more is more than any harmonic basis holds (make the mesh order the \
+                 fundamental with `fundamental.order`)"
+            ),
+        ))
+    }
+}
 
 /// Stiffness `k(φ)` over one mesh cycle, `φ = z θ + φ0` (`z` mesh cycles per fundamental period,
 /// `φ0` the phase in rad). Scene files name the shape in the field `shape`.
@@ -49,88 +73,6 @@ pub enum MeshProfile {
     /// in scene files).
     #[serde(skip)]
     Sampled(Arc<SampledProfile>),
-}
-
-/// A [`MeshProfile::Fourier`] tabulated at the shaft angles `θ_i = 2π i / N` of a mesh
-/// `φ = z θ + φ0`: a lookup at those angles, the Fourier sum elsewhere.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SampledProfile {
-    fourier: MeshProfile,
-    teeth: f64,
-    phase: f64,
-    values: Vec<f64>,
-}
-
-impl SampledProfile {
-    /// `profile` truncated to its orders `1..=orders` ([`MeshProfile::band_limited`]) and
-    /// tabulated at the `samples` shaft angles of a mesh with `teeth` cycles per revolution and
-    /// phase `phase`, by one inverse real FFT. Requires `orders · teeth < samples / 2`.
-    pub fn new(
-        profile: &MeshProfile,
-        orders: usize,
-        teeth: u32,
-        phase: f64,
-        samples: usize,
-    ) -> Self {
-        let fourier = profile.band_limited(orders);
-        let z = teeth as usize;
-        let top = (samples - 1) / 2;
-        let mut x = vec![Complex64::default(); top + 1];
-        if let MeshProfile::Fourier { mean, cos, sin } = &fourier {
-            x[0] = Complex64::new(*mean, 0.0);
-            for j in 1..=cos.len().max(sin.len()) {
-                if j * z > top {
-                    break;
-                }
-                let c = cos.get(j - 1).copied().unwrap_or(0.0);
-                let s = sin.get(j - 1).copied().unwrap_or(0.0);
-                x[j * z] += Complex64::new(c, -s) * Complex64::from_polar(1.0, j as f64 * phase);
-            }
-        } else {
-            x[0] = Complex64::new(fourier.mean(), 0.0);
-        }
-        let mut values = vec![0.0; samples];
-        if let Ok(basis) = crate::HarmonicBasis::new(1.0, top).and_then(|b| b.with_samples(samples))
-        {
-            let plan = crate::harmonic::AftPlan::new(basis);
-            let mut scratch = plan.make_scratch();
-            plan.synthesize_into(&x, |_| Complex64::new(1.0, 0.0), &mut values, &mut scratch);
-        }
-        Self {
-            fourier,
-            teeth: teeth as f64,
-            phase,
-            values,
-        }
-    }
-
-    /// The table index of mesh angle `phi`, if it sits on a tabulated angle.
-    #[inline]
-    fn index(&self, phi: f64) -> Option<usize> {
-        let n = self.values.len();
-        let x = (phi - self.phase) / self.teeth * (n as f64 / TAU);
-        let i = x.round();
-        ((x - i).abs() <= 1e-7).then(|| (i as i64).rem_euclid(n as i64) as usize)
-    }
-
-    /// The indices of `len` consecutive tabulated angles from `first` to `last`, if they are.
-    fn run(&self, first: f64, last: f64, len: usize) -> Option<impl Iterator<Item = usize>> {
-        let n = self.values.len();
-        let (a, b) = (self.index(first)?, self.index(last)?);
-        ((a + len - 1) % n == b).then(|| (a..a + len).map(move |i| i % n))
-    }
-
-    #[inline]
-    fn value(&self, phi: f64) -> f64 {
-        let n = self.values.len();
-        let x = (phi - self.phase) / self.teeth * (n as f64 / TAU);
-        let i = x.round();
-        if (x - i).abs() <= 1e-7 {
-            self.values[(i as i64).rem_euclid(n as i64) as usize]
-        } else {
-            self.fourier.value(phi)
-        }
-    }
 }
 
 impl MeshProfile {
@@ -315,7 +257,19 @@ impl MeshProfile {
             }
             MeshProfile::Cosine { mean, amplitude } => {
                 check_non_negative(context, "mean", *mean)?;
-                check_finite(context, "amplitude", *amplitude)
+                check_finite(context, "amplitude", *amplitude)?;
+                if amplitude.abs() > *mean {
+                    return Err(Error::invalid(
+                        context,
+                        "amplitude",
+                        *amplitude,
+                        format!(
+                            "at most the mean {mean} in magnitude (the stiffness falls to mean - \
+                             |amplitude|, and a mesh stiffness must not be negative)"
+                        ),
+                    ));
+                }
+                Ok(())
             }
             MeshProfile::Fourier { mean, cos, sin } => {
                 check_non_negative(context, "mean", *mean)?;
@@ -325,10 +279,53 @@ impl MeshProfile {
                 for (j, s) in sin.iter().enumerate() {
                     check_finite(context, &format!("sin[{j}]"), *s)?;
                 }
+                let orders = cos.len().max(sin.len());
+                if orders > MAX_TEETH as usize {
+                    return Err(Error::InvalidElement {
+                        context: context.into(),
+                        reason: format!(
+                            "the Fourier profile has {orders} orders, more than any harmonic \
+                             basis resolves ({MAX_TEETH})"
+                        ),
+                    });
+                }
+                let (lowest, phi) = self.fourier_minimum(orders);
+                let scale = mean + cos.iter().chain(sin).map(|c| c.abs()).sum::<f64>();
+                if lowest < -1e-9 * scale {
+                    return Err(Error::InvalidElement {
+                        context: context.into(),
+                        reason: format!(
+                            "the Fourier stiffness profile falls to {lowest:.6e} at φ = {phi:.4} \
+                             rad: a mesh stiffness must not be negative (raise `mean` or lower \
+                             the coefficients)"
+                        ),
+                    });
+                }
                 Ok(())
             }
             MeshProfile::Sampled(_) => Ok(()),
         }
+    }
+
+    /// The lowest value of a Fourier profile with `orders` orders on a grid of at least 16
+    /// points per period of its highest order (one inverse FFT), and its angle.
+    fn fourier_minimum(&self, orders: usize) -> (f64, f64) {
+        if orders == 0 {
+            return (self.mean(), 0.0);
+        }
+        let samples = (16 * orders).next_power_of_two();
+        let table = SampledProfile::new(self, orders, 1, 0.0, samples);
+        let (i, lowest) =
+            table
+                .values
+                .iter()
+                .copied()
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |a, (i, v)| if v < a.1 { (i, v) } else { a },
+                );
+        (lowest, TAU * i as f64 / samples as f64)
     }
 
     /// The profile a harmonic basis with `samples` shaft angles per revolution should evaluate

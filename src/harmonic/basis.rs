@@ -1,7 +1,7 @@
 //! The truncated Fourier basis: excitation frequency Ω, period multiple ν (fundamental Ω/ν),
 //! H harmonics, N time samples.
 
-use crate::error::{check_positive, Error, Result};
+use crate::error::{in_magnitude_range, Error, Result};
 use std::f64::consts::TAU;
 
 /// Excitation angular frequency Ω, number of harmonics H and time samples N; the period
@@ -42,10 +42,14 @@ impl HarmonicBasis {
     /// Largest period multiple ν.
     pub const MAX_SUBHARMONIC: usize = 64;
 
-    /// Ω in rad/s (finite, > 0) and H harmonics (0 = static only, at most
+    /// Ω in rad/s (finite, > 0, in [[`MIN_MAGNITUDE`], [`MAX_MAGNITUDE`]], so that the period
+    /// and `(kΩ)²` are finite) and H harmonics (0 = static only, at most
     /// [`HarmonicBasis::MAX_HARMONICS`]); N by default.
+    ///
+    /// [`MIN_MAGNITUDE`]: crate::error::MIN_MAGNITUDE
+    /// [`MAX_MAGNITUDE`]: crate::error::MAX_MAGNITUDE
     pub fn new(omega: f64, harmonics: usize) -> Result<Self> {
-        check_positive("harmonic basis", "omega", omega)?;
+        check_omega(omega)?;
         if harmonics > Self::MAX_HARMONICS {
             return Err(Error::invalid(
                 "harmonic basis",
@@ -65,7 +69,7 @@ impl HarmonicBasis {
 
     /// The same basis at another Ω (H, N and ν kept).
     pub fn with_omega(mut self, omega: f64) -> Result<Self> {
-        check_positive("harmonic basis", "omega", omega)?;
+        check_omega(omega)?;
         self.omega = omega;
         Ok(self)
     }
@@ -162,5 +166,23 @@ impl HarmonicBasis {
     #[inline]
     pub fn shaft_angle(&self, j: usize) -> f64 {
         TAU * ((j * self.subharmonic) % self.samples) as f64 / self.samples as f64
+    }
+}
+
+/// Ω must be finite, positive and in the magnitude range of scene numbers.
+fn check_omega(omega: f64) -> Result<()> {
+    if omega > 0.0 && in_magnitude_range(omega) {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "harmonic basis",
+            "omega",
+            omega,
+            format!(
+                "finite and in [{:e}, {:e}] rad/s",
+                crate::error::MIN_MAGNITUDE,
+                crate::error::MAX_MAGNITUDE
+            ),
+        ))
     }
 }

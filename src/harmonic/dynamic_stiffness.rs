@@ -9,6 +9,17 @@ use num_complex::Complex64;
 /// (nalgebra's LU only reports exactly zero pivots).
 pub const SINGULAR_PIVOT: f64 = 1e-11;
 
+/// The error for a `Z_k` (or its LU) with a non-finite entry: not a resonance, but numbers
+/// out of range (`(kΩ)² M` overflows).
+pub(crate) fn non_finite_stiffness(k: usize, w: f64) -> Error {
+    Error::NonFinite {
+        what: format!(
+            "the dynamic stiffness at harmonic {k} ({w:e} rad/s): the mass, damping or \
+             stiffness times the frequency (squared) is out of range"
+        ),
+    }
+}
+
 /// `Z_k` and its LU factors for `k = 0..=H`.
 #[derive(Debug, Clone)]
 pub struct DynamicStiffness {
@@ -53,11 +64,13 @@ impl DynamicStiffness {
             let scale = k0.amax().max(w * w * m.amax()).max(w * d0.amax());
             let lu = z.clone().lu();
             let u = lu.u();
-            let min_pivot = (0..n)
-                .map(|i| u[(i, i)].norm())
-                .fold(f64::INFINITY, f64::min);
+            let pivots = (0..n).map(|i| u[(i, i)].norm());
+            if !scale.is_finite() || pivots.clone().any(|p| !p.is_finite()) {
+                return Err(non_finite_stiffness(k, w));
+            }
+            let min_pivot = pivots.fold(f64::INFINITY, f64::min);
             let relative_pivot = if scale > 0.0 { min_pivot / scale } else { 0.0 };
-            if relative_pivot.is_nan() || relative_pivot <= SINGULAR_PIVOT {
+            if relative_pivot <= SINGULAR_PIVOT {
                 let hint = if k == 0 {
                     "K0 is singular, but not by a free rigid-body mode (free-free models are \
                      handled): a motion held only by damping to ground or by an element \
@@ -105,11 +118,13 @@ impl DynamicStiffness {
             let scale = z.iter().map(|v| v.norm()).fold(0.0, f64::max);
             let lu = z.clone().lu();
             let u = lu.u();
-            let min_pivot = (0..n)
-                .map(|i| u[(i, i)].norm())
-                .fold(f64::INFINITY, f64::min);
+            let pivots = (0..n).map(|i| u[(i, i)].norm());
+            if !scale.is_finite() || pivots.clone().any(|p| !p.is_finite()) {
+                return Err(non_finite_stiffness(k, k as f64 * fundamental));
+            }
+            let min_pivot = pivots.fold(f64::INFINITY, f64::min);
             let relative_pivot = if scale > 0.0 { min_pivot / scale } else { 0.0 };
-            if relative_pivot.is_nan() || relative_pivot <= SINGULAR_PIVOT {
+            if relative_pivot <= SINGULAR_PIVOT {
                 return Err(Error::SingularDynamicStiffness {
                     harmonic: k,
                     omega: k as f64 * fundamental,

@@ -17,6 +17,7 @@ mod packing;
 
 pub use aft::{AftPlan, AftScratch};
 pub use basis::HarmonicBasis;
+pub(crate) use dynamic_stiffness::non_finite_stiffness;
 pub use dynamic_stiffness::DynamicStiffness;
 pub use packing::{Part, RealLayout};
 

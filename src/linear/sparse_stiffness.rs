@@ -153,6 +153,12 @@ impl SparseDynamicStiffness {
         {
             let s = if k == 0 { self.shift } else { 0.0 };
             let values = self.pattern.values(w, s);
+            if values
+                .iter()
+                .any(|v| !(v.re.is_finite() && v.im.is_finite()))
+            {
+                return Err(crate::harmonic::non_finite_stiffness(k, w));
+            }
             let mut factor = None;
             if let Some((env, slots)) = &self.envelope {
                 let mut v = vec![Complex64::default(); env.size()];

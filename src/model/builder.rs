@@ -116,7 +116,8 @@ impl ModelBuilder {
         Some(Input::Sparse(SparseMatrix::from_triplets(n, &inside)))
     }
 
-    /// Adds `cos · cos(k Ω t) + sin · sin(k Ω t)` to the load on `dof` (k = 0: static).
+    /// Adds `cos · cos(k Ω t) + sin · sin(k Ω t)` to the load on `dof` (k = 0: static, with
+    /// `sin = 0`).
     pub fn load(mut self, dof: &str, order: usize, cos: f64, sin: f64) -> Self {
         self.loads.push((dof.to_string(), order, cos, sin));
         self
@@ -159,6 +160,11 @@ impl ModelBuilder {
         if n == 0 {
             return Err(Error::InvalidDofs {
                 reason: "the model has no DOFs".into(),
+            });
+        }
+        if n > Model::MAX_DOFS {
+            return Err(Error::InvalidDofs {
+                reason: format!("{n} DOFs, more than the limit of {}", Model::MAX_DOFS),
             });
         }
         let mut by_name = std::collections::HashMap::with_capacity(n);
@@ -219,11 +225,19 @@ impl ModelBuilder {
             let i = index(&ctx, dof)?;
             crate::error::check_finite(&ctx, "cos", *c)?;
             crate::error::check_finite(&ctx, "sin", *s)?;
+            if *order == 0 && *s != 0.0 {
+                return Err(Error::invalid(
+                    &ctx,
+                    "sin",
+                    *s,
+                    "0 on a static load (order 0, where sin(0 Ωt) = 0)",
+                ));
+            }
             loads.push(Load {
                 dof: i,
                 order: *order,
                 cos: *c,
-                sin: if *order == 0 { 0.0 } else { *s },
+                sin: *s,
             });
         }
 
@@ -256,6 +270,12 @@ impl ModelBuilder {
                     });
                 }
                 w.push((i, *wi));
+            }
+            if w.iter().all(|(_, wi)| *wi == 0.0) {
+                return Err(Error::InvalidElement {
+                    context: ctx,
+                    reason: "every weight is 0: its coordinate u = Σ w q is always 0".into(),
+                });
             }
             law.validate(&ctx)?;
             let linear = law.linear_part();

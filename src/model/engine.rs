@@ -103,6 +103,9 @@ fn four() -> u32 {
 const MAX_DENOMINATOR: u64 = 1000;
 
 impl EngineExcitation {
+    /// Largest number of cylinders (the largest engines have 24).
+    pub const MAX_CYLINDERS: usize = 64;
+
     /// The number of cylinders.
     pub fn count(&self) -> usize {
         match &self.cylinders {
@@ -155,6 +158,12 @@ impl EngineExcitation {
         };
         if n == 0 {
             return Err(bad("cylinders", "must name at least one cylinder".into()));
+        }
+        if n > Self::MAX_CYLINDERS {
+            return Err(bad(
+                "cylinders",
+                format!("must be at most {}, got {n}", Self::MAX_CYLINDERS),
+            ));
         }
         match (&self.cylinders, &self.dof) {
             (Cylinders::Count(_), None) => {

@@ -20,7 +20,7 @@
 //! `(1, -i)` and the stiffness is torsional, in N m/rad referred to the driving gear.
 
 use crate::error::{check_finite, check_non_negative, Error, Result};
-use crate::force::{Backlash, Flank, ForceLaw, MeshDamping, MeshProfile, MeshStiffness};
+use crate::force::{Backlash, Flank, ForceLaw, MeshDamping, MeshProfile, MeshStiffness, MAX_TEETH};
 
 /// A gear stage between a driving and a driven DOF (module documentation for the signs).
 ///
@@ -160,10 +160,15 @@ impl GearStage {
     /// Mesh cycles per period of the fundamental, `z1 · shaft_order / f`, if it is a whole
     /// number >= 1 (to 1e-9).
     pub fn mesh_order(&self) -> Option<u32> {
-        let z = self.teeth as f64 * self.shaft_order / self.fundamental_order;
+        let z = self.mesh_cycles();
         let r = z.round();
         (z.is_finite() && r >= 1.0 && r <= u32::MAX as f64 && (z - r).abs() <= 1e-9 * z.max(1.0))
             .then_some(r as u32)
+    }
+
+    /// Mesh cycles per period of the fundamental, `z1 · shaft_order / f`, as a real number.
+    fn mesh_cycles(&self) -> f64 {
+        self.teeth as f64 * self.shaft_order / self.fundamental_order
     }
 
     /// Checks every field; `context` names the element.
@@ -187,11 +192,24 @@ impl GearStage {
                 reason: format!("`driving` and `driven` are the same DOF `{}`", self.driving),
             });
         }
-        if self.teeth == 0 {
-            return Err(Error::invalid(context, "teeth", 0.0, "an integer >= 1"));
-        }
+        crate::force::check_teeth(context, self.teeth)?;
         check_positive(context, "shaft_order", self.shaft_order)?;
         check_positive(context, "fundamental_order", self.fundamental_order)?;
+        let z = self.mesh_cycles();
+        if z > MAX_TEETH as f64 + 0.5 {
+            return Err(Error::invalid(
+                context,
+                "shaft_order",
+                self.shaft_order,
+                format!(
+                    "such that the mesh cycles per period of the fundamental, teeth x \
+                     shaft_order / fundamental order = {} x {} / {} = {z:.6e}, are at most \
+                     {MAX_TEETH} (the highest order any harmonic basis resolves): make the mesh \
+                     order the fundamental with `fundamental.order`",
+                    self.teeth, self.shaft_order, self.fundamental_order
+                ),
+            ));
+        }
         if self.mesh_order().is_none() {
             return Err(Error::invalid(
                 context,

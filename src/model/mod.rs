@@ -106,6 +106,10 @@ impl Model {
     /// Largest model (in DOFs) whose matrices are copied densely: `n²` entries each.
     pub const MAX_DENSE_DOFS: usize = 4096;
 
+    /// Largest model in DOFs (a million; the harmonic-balance system of a large model is
+    /// bounded further by [`MAX_SYSTEM_BYTES`](crate::residual::MAX_SYSTEM_BYTES)).
+    pub const MAX_DOFS: usize = 1_000_000;
+
     /// Dense copies of M, D, K, D0, K0 for `context`, which works densely; an error for a
     /// model above [`Model::MAX_DENSE_DOFS`] DOFs.
     pub fn dense(&self, context: &str) -> Result<DenseMatrices> {

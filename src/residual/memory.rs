@@ -86,11 +86,7 @@ impl HarmonicBalance<'_> {
         for ((f, &u), &du) in ws.f.iter_mut().zip(&ws.u).zip(&ws.du) {
             *f -= lin.offset + lin.stiffness * u + lin.damping * du;
         }
-        if !ws.f.iter().all(|v| v.is_finite()) {
-            return Err(Error::NonFinite {
-                what: format!("force of element `{}`", e.name()),
-            });
-        }
+        self.samples(ws).check("force", e.name(), &ws.f)?;
         self.aft.analyze_into(&mut ws.f, &mut ws.uk, &mut ws.aft);
         ws.ffts += 3;
         for k in 0..=h {
@@ -107,11 +103,8 @@ impl HarmonicBalance<'_> {
                 let (pu, pv) = direction(trig, omega, j, c);
                 *g = d - lin.stiffness * pu - lin.damping * pv;
             }
-            if !ws.gu.iter().all(|v| v.is_finite()) {
-                return Err(Error::NonFinite {
-                    what: format!("force derivatives of element `{}`", e.name()),
-                });
-            }
+            self.samples(ws)
+                .check("force derivative", e.name(), &ws.gu)?;
             self.aft.analyze_into(&mut ws.gu, &mut ws.uk, &mut ws.aft);
             ws.ffts += 1;
             ws.column[0] = ws.uk[0].re;

@@ -16,8 +16,11 @@ use crate::linear::Formulation;
 use crate::model::Model;
 
 mod condensed;
+mod limits;
+mod located;
 mod memory;
 use crate::solution::SolveStats;
+pub use limits::{estimate_bytes, MAX_SYSTEM_BYTES};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
@@ -156,11 +159,12 @@ impl<'m> HarmonicBalance<'m> {
                 samples: basis.samples(),
             });
         }
+        limits::check_size(model, &basis, formulation)?;
         let mut f_ext = vec![Complex64::default(); (h + 1) * n];
         let nu = basis.subharmonic();
         for l in model.loads() {
             // Order k of the shaft is harmonic νk of the fundamental Ω/ν.
-            if l.order * nu > h {
+            if l.order.saturating_mul(nu) > h {
                 return Err(Error::LoadOrderTooHigh {
                     dof: model.dof_names()[l.dof].clone(),
                     order: l.order,
@@ -172,7 +176,7 @@ impl<'m> HarmonicBalance<'m> {
         // H = 0 is a static analysis by choice; otherwise every time variation must fit.
         for e in model.elements().iter().filter(|_| h > 0) {
             if let Some(order) = e.law().time_order() {
-                if order * nu > h {
+                if order.saturating_mul(nu) > h {
                     return Err(Error::ElementOrderTooHigh {
                         element: e.name().to_string(),
                         order,
@@ -414,11 +418,7 @@ impl<'m> HarmonicBalance<'m> {
                 ws.f[j] = mean - lin.offset - lin.stiffness * u - lin.damping * du;
             }
             ws.force_evaluations += self.basis.samples() + 2 * act.jump_samples.len();
-            if !ws.f.iter().all(|v| v.is_finite()) {
-                return Err(Error::NonFinite {
-                    what: format!("force of element `{}`", e.name()),
-                });
-            }
+            self.samples(ws).check("force", e.name(), &ws.f)?;
             // Contact edges crossed between samples: the trapezoid error, from the local
             // harmonics still in `uk` (see [`crate::harmonic::kinks`]).
             ws.crossings.clear();
@@ -451,11 +451,9 @@ impl<'m> HarmonicBalance<'m> {
                     *g -= lin.stiffness;
                     *d -= lin.damping;
                 }
-                if !ws.gu.iter().chain(&ws.gdu).all(|v| v.is_finite()) {
-                    return Err(Error::NonFinite {
-                        what: format!("force derivatives of element `{}`", e.name()),
-                    });
-                }
+                let samples = self.samples(ws);
+                samples.check("force derivative ∂f/∂u", e.name(), &ws.gu)?;
+                samples.check("force derivative ∂f/∂u̇", e.name(), &ws.gdu)?;
                 self.aft
                     .spectrum_into(&mut ws.gu, &mut ws.spec_u, &mut ws.aft);
                 self.aft
@@ -530,11 +528,7 @@ impl<'m> HarmonicBalance<'m> {
                     *f = (g - d0) * du / omega;
                 }
             }
-            if !b.f.iter().all(|v| v.is_finite()) {
-                return Err(Error::NonFinite {
-                    what: format!("Ω-derivative of element `{}`", e.name()),
-                });
-            }
+            self.samples(b).check("Ω-derivative", e.name(), &b.f)?;
             self.aft.analyze_into(&mut b.f, &mut b.uk, &mut b.aft);
             b.ffts += 3;
             for k in 0..=h {

@@ -82,6 +82,15 @@ pub(super) fn read(value: &Value, base: &Path) -> Result<Dofs, (String, String)>
                     count: Some(count),
                     prefix,
                 } => {
+                    if count > crate::Model::MAX_DOFS {
+                        return Err(e(
+                            "dofs.count",
+                            format!(
+                                "must be at most {} (the largest model), got {count}",
+                                crate::Model::MAX_DOFS
+                            ),
+                        ));
+                    }
                     let prefix = prefix.unwrap_or_else(|| "dof".to_string());
                     if prefix.trim().is_empty() {
                         return Err(e("dofs.prefix", "must not be empty".into()));
@@ -121,6 +130,17 @@ pub(super) fn read(value: &Value, base: &Path) -> Result<Dofs, (String, String)>
                 };
                 (path, x.into_inner().to_string())
             })?;
+            let mut first = std::collections::HashMap::new();
+            for (i, name) in names.iter().enumerate() {
+                if let Some(j) = first.insert(name.as_str(), i) {
+                    return Err(e(
+                        &format!("dofs[{i}]"),
+                        format!(
+                            "DOF `{name}` appears twice (first at dofs[{j}]): names are unique"
+                        ),
+                    ));
+                }
+            }
             Dofs {
                 names,
                 origin: None,

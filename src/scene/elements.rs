@@ -58,6 +58,12 @@ pub(super) fn add(
                 ))
             }
         };
+        if connects.values().all(|w| *w == 0.0) {
+            return Err(fail(
+                &at("connects"),
+                "needs a DOF with a nonzero weight (the coordinate is u = Σ w q)".into(),
+            ));
+        }
         for dof in connects.keys() {
             if !known.contains(dof.as_str()) {
                 return Err(fail(
@@ -132,6 +138,19 @@ pub(super) fn add(
                 }
                 fail(&path, message)
             })?;
+        // The law's own check, located at its field (the model checks it again).
+        law.validate(&format!("element `{name}`")).map_err(|x| {
+            let path = match &x {
+                crate::Error::InvalidParameter { name, .. } => {
+                    locate(&element, name, false, String::new()).map(|p| at(&p))
+                }
+                _ => None,
+            };
+            fail(
+                &path.unwrap_or_else(|| format!("elements[{i}]")),
+                x.to_string(),
+            )
+        })?;
         let law = match offset {
             Some(u0) => Box::new(crate::force::Offset::boxed(u0, law)),
             None => law,

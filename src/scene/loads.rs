@@ -28,6 +28,8 @@ pub(super) fn engine_error(e: crate::Error) -> (String, String) {
         crate::Error::InvalidParameter { name, .. } => {
             fail(&format!("engine.{name}"), e.to_string())
         }
+        // The path already says `engine`.
+        crate::Error::InvalidElement { reason, .. } => fail("engine", reason.clone()),
         _ => fail("engine", e.to_string()),
     }
 }
@@ -66,6 +68,16 @@ pub(super) fn add(
                     "unknown DOF `{}` (the scene has: {})",
                     l.dof,
                     dofs.listing()
+                ),
+            ));
+        }
+        if l.order == 0 && l.sin != 0.0 {
+            return Err(fail(
+                &format!("loads[{i}].sin"),
+                format!(
+                    "must be 0 on a static load (order 0, where sin(0 Ωt) = 0), got {}: give \
+                     the static load in `cos`",
+                    l.sin
                 ),
             ));
         }

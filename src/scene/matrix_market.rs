@@ -266,6 +266,13 @@ fn entry(
     if !value.is_finite() {
         return Err(format!("value `{v}` is not finite"));
     }
+    if !crate::error::in_magnitude_range(value) {
+        return Err(format!(
+            "value `{v}` must be 0 or between {:e} and {:e} in magnitude",
+            crate::error::MIN_MAGNITUDE,
+            crate::error::MAX_MAGNITUDE
+        ));
+    }
     Ok((i, j, value))
 }
 

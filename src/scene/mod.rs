@@ -39,9 +39,9 @@ pub mod matrix_market;
 mod paths;
 mod solver;
 
-use paths::{field_path, is_json, line_col, non_finite, strip_position};
+use paths::{field_path, is_json, line_col, non_finite, out_of_range, strip_position};
 use solver::SolverSpec;
-pub use solver::METHODS;
+pub use solver::{check_tolerance, MAX_ITERATIONS, METHODS, MIN_TOLERANCE};
 
 use crate::solve::Method;
 use crate::{HarmonicBasis, Model};
@@ -163,6 +163,17 @@ impl Scene {
             path,
             message,
         };
+        if let Some((path, x)) = out_of_range(&value, String::new()) {
+            return Err(err(
+                None,
+                Some(path),
+                format!(
+                    "must be 0 or between {:e} and {:e} in magnitude, got {x:e}",
+                    crate::error::MIN_MAGNITUDE,
+                    crate::error::MAX_MAGNITUDE
+                ),
+            ));
+        }
         let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
             let path = e.path().to_string();
             let message = e.into_inner().to_string();
@@ -311,7 +322,16 @@ pub fn set_parameter(doc: &mut Value, path: &str, x: f64) -> Result<(), String> 
     if !cur.is_number() {
         return Err(format!("`{path}` is not a number in the scene"));
     }
-    *cur = serde_json::json!(x);
+    // A whole value stays a whole number where the scene has one, so that whole-number fields
+    // (`harmonics.count`, `teeth`, a load's `order`) take it.
+    let whole = !cur.is_f64() && x.fract() == 0.0;
+    *cur = if whole && (0.0..=u64::MAX as f64).contains(&x) {
+        serde_json::json!(x as u64)
+    } else if whole && (i64::MIN as f64..0.0).contains(&x) {
+        serde_json::json!(x as i64)
+    } else {
+        serde_json::json!(x)
+    };
     Ok(())
 }
 

@@ -23,6 +23,31 @@ pub(super) fn non_finite(v: &toml::Value, path: String) -> Option<(String, f64)>
     }
 }
 
+/// The path of the first number in `v` that is not 0 and outside the magnitude range
+/// [[`MIN_MAGNITUDE`](crate::error::MIN_MAGNITUDE),
+/// [`MAX_MAGNITUDE`](crate::error::MAX_MAGNITUDE)], with its value.
+pub(super) fn out_of_range(v: &Value, path: String) -> Option<(String, f64)> {
+    let child = |k: &str| {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    };
+    match v {
+        Value::Number(x) => {
+            let x = x.as_f64().unwrap_or(f64::NAN);
+            (!crate::error::in_magnitude_range(x)).then_some((path, x))
+        }
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| out_of_range(x, format!("{path}[{i}]"))),
+        Value::Object(m) => m.iter().find_map(|(k, x)| out_of_range(x, child(k))),
+        _ => None,
+    }
+}
+
 /// Where in `v` a key named `key` (or, with `as_value`, a string equal to it) sits, as a path.
 pub(super) fn locate(v: &Value, needle: &str, as_value: bool, path: String) -> Option<String> {
     match v {

@@ -18,11 +18,42 @@ pub(super) struct SolverSpec {
     depth: Option<usize>,
 }
 
+/// Smallest relative residual tolerance of a scene (and of `--tolerance`): the residual stops
+/// at rounding, about 1e-16, so a smaller tolerance is never met.
+pub const MIN_TOLERANCE: f64 = 1e-15;
+
+/// Largest `solver.max_iterations` of a scene.
+pub const MAX_ITERATIONS: usize = 1_000_000;
+
+/// Checks a scene's relative residual tolerance: in [[`MIN_TOLERANCE`], 1). (The library
+/// accepts 0, for a fixed number of iterations.)
+pub fn check_tolerance(tolerance: f64) -> Result<(), String> {
+    if tolerance.is_finite() && (MIN_TOLERANCE..1.0).contains(&tolerance) {
+        Ok(())
+    } else {
+        Err(format!(
+            "must be in [{MIN_TOLERANCE:e}, 1) (the relative residual stops at rounding, about \
+             1e-16), got {tolerance}"
+        ))
+    }
+}
+
 impl SolverSpec {
     /// The method, optionally overriding the name.
     pub(super) fn method(&self, name: Option<&str>) -> Result<Method, (String, String)> {
         let name = name.or(self.method.as_deref()).unwrap_or("newton");
         let e = |field: &str, x: crate::Error| (format!("solver.{field}"), x.to_string());
+        if let Some(t) = self.tolerance {
+            check_tolerance(t).map_err(|m| ("solver.tolerance".to_string(), m))?;
+        }
+        if let Some(m) = self.max_iterations {
+            if !(1..=MAX_ITERATIONS).contains(&m) {
+                return Err((
+                    "solver.max_iterations".into(),
+                    format!("must be in 1..={MAX_ITERATIONS}, got {m}"),
+                ));
+            }
+        }
         let method = match name {
             "fixed_point" => {
                 let mut o = FixedPoint::new();

@@ -210,9 +210,7 @@ impl AndersonSolver {
             Ok(_) => Err(Termination::NonFinite {
                 what: "residual or linear solve".into(),
             }),
-            Err(e) => Err(Termination::NonFinite {
-                what: e.to_string(),
-            }),
+            Err(e) => Err(Termination::from_error(&e)),
         }
     }
 

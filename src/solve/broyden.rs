@@ -171,7 +171,7 @@ impl BroydenSolver {
         match rel {
             Ok(rel) if rel.is_finite() => self.rel = rel,
             Ok(_) => return Some(nonfinite("residual")),
-            Err(e) => return Some(nonfinite(&e.to_string())),
+            Err(e) => return Some(Termination::from_error(&e)),
         }
         p.count_factorization();
         if !lu::factor_in_place(&mut self.jac, &mut self.perm) {

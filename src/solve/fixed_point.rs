@@ -164,16 +164,21 @@ impl FixedPointSolver {
                 self.best = self.best.min(rel);
                 state.cost(rel)
             }
-            Ok(_) => self.fail(state, "residual or linear solve".into()),
-            Err(e) => self.fail(state, e.to_string()),
+            Ok(_) => self.fail(
+                state,
+                Termination::NonFinite {
+                    what: "residual or linear solve".into(),
+                },
+            ),
+            Err(e) => self.fail(state, Termination::from_error(&e)),
         }
     }
 
-    fn fail(&mut self, state: HbState, what: String) -> HbState {
+    fn fail(&mut self, state: HbState, why: Termination) -> HbState {
         if !self.progress.history.is_empty() {
             self.progress.x.copy_from_slice(&self.x_prev);
         }
-        self.progress.stop(state, Termination::NonFinite { what })
+        self.progress.stop(state, why)
     }
 }
 

@@ -164,7 +164,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
                 Ok((state.cost(rel), None))
             }
             Ok(_) => Ok((self.progress.stop(state, nonfinite("residual")), None)),
-            Err(e) => Ok((self.progress.stop(state, nonfinite(&e.to_string())), None)),
+            Err(e) => Ok((self.progress.stop(state, Termination::from_error(&e)), None)),
         }
     }
 
@@ -213,7 +213,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
         // The Jacobian for the next step, unless this one is the last.
         if rel > self.options.tolerance {
             if let Err(e) = p.residual(&self.progress.x, &mut self.r, Some(&mut self.jac)) {
-                return Ok((self.progress.stop(state, nonfinite(&e.to_string())), None));
+                return Ok((self.progress.stop(state, Termination::from_error(&e)), None));
             }
         }
         Ok((state.cost(rel), None))

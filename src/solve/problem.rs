@@ -74,7 +74,49 @@ impl<'a, 'm> HbProblem<'a, 'm> {
         ws.stats.residual_evaluations += 1;
         self.hb.residual_real_into(x, r, jac, &mut ws)?;
         let rel = self.relative(&ws, self.layout().norm(r));
+        if !rel.is_finite() {
+            return Err(self.non_finite("the residual", r));
+        }
         Ok(rel)
+    }
+
+    /// The error for a non-finite `what` in the real layout `v`: its first non-finite entry,
+    /// or, where every entry is finite and only the norm overflows, its largest, named by
+    /// harmonic and unknown (a DOF, or `u(element)` when condensed).
+    fn non_finite(&self, what: &str, v: &[f64]) -> crate::Error {
+        let n = self.layout().n.max(1);
+        let (index, overflow) = match v.iter().position(|x| !x.is_finite()) {
+            Some(i) => (i, false),
+            None => (
+                (0..v.len())
+                    .max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs()))
+                    .unwrap_or(0),
+                true,
+            ),
+        };
+        let block = index / n;
+        let k = block.div_ceil(2);
+        let part = if block == 0 || block % 2 == 1 {
+            "cos"
+        } else {
+            "sin"
+        };
+        let name = self
+            .hb
+            .unknown_names()
+            .get(index % n)
+            .map_or("?", String::as_str);
+        crate::Error::NonFinite {
+            what: if overflow {
+                format!(
+                    "the norm of {what} (its largest entry, {:e}, at harmonic {k} ({part}) of \
+                     `{name}`, overflows when squared)",
+                    v.get(index).copied().unwrap_or(f64::NAN)
+                )
+            } else {
+                format!("{what} at harmonic {k} ({part}) of `{name}`")
+            },
+        }
     }
 
     /// The paper's map `g ← G(x) = Z⁻¹ (F_ext - F_rest(x))` (steps 2a-2c, one per-harmonic solve)
@@ -117,7 +159,11 @@ impl<'a, 'm> HbProblem<'a, 'm> {
             }
         }
         layout.pack(&ws.rhs, g);
-        Ok(self.relative(ws, r2.sqrt()))
+        let rel = self.relative(ws, r2.sqrt());
+        if !(rel.is_finite() && g.iter().all(|v| v.is_finite())) {
+            return Err(self.non_finite("the fixed-point map (a linear solve)", g));
+        }
+        Ok(rel)
     }
 
     /// The full harmonics of the unknowns `q` (see

@@ -29,10 +29,13 @@ pub struct Progress {
 
 impl Progress {
     pub(crate) fn new(x0: Vec<f64>, max_iterations: usize) -> Self {
+        // Room for the usual solve, so that iterating does not allocate; a larger (or absurd)
+        // iteration limit grows the history as needed instead of reserving it all.
+        let capacity = max_iterations.min(PREALLOCATED_ITERATIONS) + 2;
         Self {
             x: x0,
-            history: Vec::with_capacity(max_iterations + 2),
-            seconds: Vec::with_capacity(max_iterations + 2),
+            history: Vec::with_capacity(capacity),
+            seconds: Vec::with_capacity(capacity),
             termination: None,
             start: Some(Instant::now()),
         }
@@ -51,6 +54,9 @@ impl Progress {
         state.terminate_with(TerminationReason::SolverExit(String::new()))
     }
 }
+
+/// Iterations whose history is reserved before a solve starts.
+const PREALLOCATED_ITERATIONS: usize = 1 << 16;
 
 /// A solver that exposes its [`Progress`].
 pub trait HbSolver {
@@ -111,6 +117,21 @@ pub(crate) fn initial_x(
         for k in 0..=layout.h {
             hb.dynamic_stiffness()
                 .solve_in_place(k, &mut q[k * n..(k + 1) * n]);
+        }
+        if let Some(i) = q
+            .iter()
+            .position(|v| !(v.re.is_finite() && v.im.is_finite()))
+        {
+            return Err(Error::NonFinite {
+                what: format!(
+                    "the linear solution at harmonic {} of `{}` (the loads are out of range \
+                     for the model)",
+                    i / n.max(1),
+                    hb.unknown_names()
+                        .get(i % n.max(1))
+                        .map_or("?", String::as_str)
+                ),
+            });
         }
         layout.pack(&q, &mut x);
     }
@@ -203,17 +224,40 @@ where
         .ok_or_else(|| Error::Solver {
             reason: "argmin returned no problem".into(),
         })?;
+    let mut history = progress.history.clone();
+    let mut history_seconds = progress.seconds.clone();
+    if history.is_empty() {
+        // The start failed before its residual was recorded (its Jacobian, say): the
+        // residual alone, or, if that is not finite either, no iterate at all, only where.
+        let mut r = vec![0.0; progress.x.len()];
+        history.push(problem.residual(&progress.x, &mut r, None)?);
+        history_seconds.push(start.elapsed().as_secs_f64());
+    }
     let stats = problem.take_stats();
     let mut unknowns = vec![Complex64::default(); hb.len()];
     hb.layout().unpack(&progress.x, &mut unknowns);
     let harmonics = problem.full_harmonics(&unknowns)?;
+    let names = hb.model().dof_names();
+    if let Some(i) = harmonics
+        .iter()
+        .position(|v| !(v.re.is_finite() && v.im.is_finite()))
+    {
+        let n = names.len().max(1);
+        return Err(Error::NonFinite {
+            what: format!(
+                "harmonic {} of DOF `{}` of the last iterate",
+                i / n,
+                names.get(i % n).map_or("?", String::as_str)
+            ),
+        });
+    }
     Ok(Solution {
         basis: *hb.basis(),
         dofs: hb.model().dof_names().to_vec(),
         harmonics,
         termination,
-        history: progress.history.clone(),
-        history_seconds: progress.seconds.clone(),
+        history,
+        history_seconds,
         stats,
         wall_time: start.elapsed(),
     })

@@ -9,7 +9,7 @@
 
 use super::coarse::coarse_harmonics;
 use super::{Anderson, Broyden, FixedPoint, Method, Newton};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::residual::{HarmonicBalance, Workspace};
 use crate::solution::Solution;
 use num_complex::Complex64;
@@ -33,12 +33,16 @@ pub fn robust_start(
     tolerance: f64,
     ws: &mut Workspace,
 ) -> Result<StartReport> {
-    let first = method.solve(hb, initial, ws)?;
-    if first.is_converged() {
-        return Ok(StartReport {
-            solution: first,
-            how: method.name().to_string(),
-        });
+    // A non-finite value at the start of one attempt (a linear start out of range) leaves the
+    // others to try: an `Err` is kept until one of them gives a solution.
+    let first = attempt(method.solve(hb, initial, ws))?;
+    if let Ok(sol) = &first {
+        if sol.is_converged() {
+            return Ok(StartReport {
+                solution: first?,
+                how: method.name().to_string(),
+            });
+        }
     }
     let fallbacks = [
         Method::Newton(Newton::new().with_tolerance(tolerance)?),
@@ -58,18 +62,20 @@ pub fn robust_start(
         if m.name() == method.name() && initial.is_none() {
             continue;
         }
-        let sol = m.solve(hb, None, ws)?;
-        if sol.is_converged() {
-            return Ok(StartReport {
-                solution: sol,
-                how: format!("{} (fallback)", m.name()),
-            });
+        if let Ok(sol) = attempt(m.solve(hb, None, ws))? {
+            if sol.is_converged() {
+                return Ok(StartReport {
+                    solution: sol,
+                    how: format!("{} (fallback)", m.name()),
+                });
+            }
         }
     }
     let newton = Newton::new().with_tolerance(tolerance)?;
     if let Some(sol) = load_homotopy(hb, &newton, ws)? {
         return Ok(sol);
     }
+    let first = first?;
     Ok(StartReport {
         how: format!(
             "{} failed ({}), as did every fallback and the load homotopy",
@@ -78,6 +84,16 @@ pub fn robust_start(
         ),
         solution: first,
     })
+}
+
+/// Sorts the outcome of one attempt: a solution or a non-finite value go on (`Ok`), any other
+/// error ends the start (`Err`).
+fn attempt(result: Result<Solution>) -> Result<Result<Solution>> {
+    match result {
+        Err(e @ Error::NonFinite { .. }) => Ok(Err(e)),
+        Err(e) => Err(e),
+        Ok(sol) => Ok(Ok(sol)),
+    }
 }
 
 /// Newton along `s = s0 → 1` with the alternating load scaled by `s`.
@@ -98,12 +114,12 @@ fn load_homotopy(
     let mut steps = 0;
     let result = loop {
         set(hb, &mut scale, s);
-        let sol = match &current {
-            Some(c) => newton.solve_from(hb, c.harmonics(), ws)?,
-            None => newton.solve(hb, ws)?,
-        };
+        let sol = attempt(match &current {
+            Some(c) => newton.solve_from(hb, c.harmonics(), ws),
+            None => newton.solve(hb, ws),
+        })?;
         steps += 1;
-        if sol.is_converged() {
+        if let Some(sol) = sol.ok().filter(Solution::is_converged) {
             if s >= 1.0 {
                 break Some(sol);
             }

@@ -1,0 +1,93 @@
+//! A band-limited mesh-stiffness profile tabulated at the AFT's sample angles: a lookup where
+//! the AFT evaluates it, the Fourier sum elsewhere.
+
+use super::MeshProfile;
+use num_complex::Complex64;
+use std::f64::consts::TAU;
+
+/// A [`MeshProfile::Fourier`] tabulated at the shaft angles `θ_i = 2π i / N` of a mesh
+/// `φ = z θ + φ0`: a lookup at those angles, the Fourier sum elsewhere.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampledProfile {
+    pub(super) fourier: MeshProfile,
+    teeth: f64,
+    phase: f64,
+    pub(super) values: Vec<f64>,
+}
+
+impl SampledProfile {
+    /// `profile` truncated to its orders `1..=orders` ([`MeshProfile::band_limited`]) and
+    /// tabulated at the `samples` shaft angles of a mesh with `teeth` cycles per revolution and
+    /// phase `phase`, by one inverse real FFT. Requires `orders · teeth < samples / 2`.
+    pub fn new(
+        profile: &MeshProfile,
+        orders: usize,
+        teeth: u32,
+        phase: f64,
+        samples: usize,
+    ) -> Self {
+        let fourier = profile.band_limited(orders);
+        let z = teeth as usize;
+        let top = (samples - 1) / 2;
+        let mut x = vec![Complex64::default(); top + 1];
+        if let MeshProfile::Fourier { mean, cos, sin } = &fourier {
+            x[0] = Complex64::new(*mean, 0.0);
+            for j in 1..=cos.len().max(sin.len()) {
+                if j * z > top {
+                    break;
+                }
+                let c = cos.get(j - 1).copied().unwrap_or(0.0);
+                let s = sin.get(j - 1).copied().unwrap_or(0.0);
+                x[j * z] += Complex64::new(c, -s) * Complex64::from_polar(1.0, j as f64 * phase);
+            }
+        } else {
+            x[0] = Complex64::new(fourier.mean(), 0.0);
+        }
+        let mut values = vec![0.0; samples];
+        if let Ok(basis) = crate::HarmonicBasis::new(1.0, top).and_then(|b| b.with_samples(samples))
+        {
+            let plan = crate::harmonic::AftPlan::new(basis);
+            let mut scratch = plan.make_scratch();
+            plan.synthesize_into(&x, |_| Complex64::new(1.0, 0.0), &mut values, &mut scratch);
+        }
+        Self {
+            fourier,
+            teeth: teeth as f64,
+            phase,
+            values,
+        }
+    }
+
+    /// The table index of mesh angle `phi`, if it sits on a tabulated angle.
+    #[inline]
+    fn index(&self, phi: f64) -> Option<usize> {
+        let n = self.values.len();
+        let x = (phi - self.phase) / self.teeth * (n as f64 / TAU);
+        let i = x.round();
+        ((x - i).abs() <= 1e-7).then(|| (i as i64).rem_euclid(n as i64) as usize)
+    }
+
+    /// The indices of `len` consecutive tabulated angles from `first` to `last`, if they are.
+    pub(super) fn run(
+        &self,
+        first: f64,
+        last: f64,
+        len: usize,
+    ) -> Option<impl Iterator<Item = usize>> {
+        let n = self.values.len();
+        let (a, b) = (self.index(first)?, self.index(last)?);
+        ((a + len - 1) % n == b).then(|| (a..a + len).map(move |i| i % n))
+    }
+
+    #[inline]
+    pub(super) fn value(&self, phi: f64) -> f64 {
+        let n = self.values.len();
+        let x = (phi - self.phase) / self.teeth * (n as f64 / TAU);
+        let i = x.round();
+        if (x - i).abs() <= 1e-7 {
+            self.values[(i as i64).rem_euclid(n as i64) as usize]
+        } else {
+            self.fourier.value(phi)
+        }
+    }
+}
