@@ -35,7 +35,9 @@ pub(crate) fn compare(
         let method: Method = args.method_named(&scene, name)?;
         let mut ws = hb.workspace();
         let start = Instant::now();
-        let sol = method.solve(&hb, None, &mut ws)?;
+        let sol = method
+            .solve(&hb, None, &mut ws)
+            .map_err(|e| super::failure(e, &scene.file))?;
         solutions.push((name, start.elapsed().as_secs_f64(), sol));
     }
     // The time-domain reference starts on the first converged HB orbit (from rest if none):
@@ -128,7 +130,7 @@ pub(crate) fn compare(
             &Axis::log("relative residual"),
             &histories,
         )
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        .unwrap_or_else(super::plot_warning);
     }
     Ok(if any_converged { 0 } else { 1 })
 }

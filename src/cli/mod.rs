@@ -62,6 +62,34 @@ pub(crate) fn exit_code(e: &hbal::Error) -> u8 {
     }
 }
 
+/// A plot that cannot be drawn (nothing finite to show) is a warning on stderr: the
+/// computation and its CSV files stand, and the exit code stays the computation's.
+pub(crate) fn plot_warning(e: Box<dyn std::error::Error>) {
+    eprintln!("warning: plot: {e}");
+}
+
+/// A library error with the scene's name and its exit code ([`exit_code`]).
+pub(crate) fn failure(e: hbal::Error, file: &str) -> Failure {
+    Failure {
+        code: exit_code(&e),
+        error: anyhow::Error::new(e).context(file.to_string()),
+    }
+}
+
+/// A library error along a sweep whose input was checked at its first point: a singular
+/// dynamic stiffness or a failed solve further on is a numerical failure (exit 1); only a
+/// model too large to set up stays bad input (exit 2).
+pub(crate) fn sweep_failure(e: hbal::Error, file: &str) -> Failure {
+    let code = match e {
+        hbal::Error::TooLarge { .. } => 2,
+        _ => 1,
+    };
+    Failure {
+        code,
+        error: anyhow::Error::new(e).context(file.to_string()),
+    }
+}
+
 /// The solver overrides of `solve`, `compare` and `sweep`.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub(crate) struct SolverArgs {

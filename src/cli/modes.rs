@@ -48,7 +48,10 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     // The operating point: the periodic solution at the scene's speed.
     let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
         .with_context(|| scene.file.clone())?;
-    let sol = scene.method.solve(&hb, None, &mut hb.workspace())?;
+    let sol = scene
+        .method
+        .solve(&hb, None, &mut hb.workspace())
+        .map_err(|e| super::failure(e, &scene.file))?;
     if !sol.is_converged() {
         return Err(Failure {
             code: 1,
@@ -59,10 +62,8 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
             ),
         });
     }
-    let nf = natural_frequencies(&scene.model, &sol, max_hz).map_err(|e| Failure {
-        code: super::exit_code(&e),
-        error: anyhow::Error::new(e).context(scene.file.clone()),
-    })?;
+    let nf = natural_frequencies(&scene.model, &sol, max_hz)
+        .map_err(|e| super::failure(e, &scene.file))?;
     let orders: Vec<f64> = super::excitation_orders(&scene, &scene.basis)
         .into_iter()
         .map(|(o, _)| o)

@@ -233,7 +233,7 @@ pub(crate) fn write(
             &Axis::auto(format!("amplitude ({unit})")),
             &series,
         )
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        .unwrap_or_else(super::plot_warning);
     }
     if branch.points.len() >= 2 && stems > 0 {
         let highlight: Vec<f64> = orders.iter().map(|o| o.0).collect();
@@ -248,7 +248,7 @@ pub(crate) fn write(
             },
             &slices,
         )
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        .unwrap_or_else(super::plot_warning);
     }
     Ok(())
 }

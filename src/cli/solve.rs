@@ -64,10 +64,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 .into());
             }
             let a = hbal::solve::solve_auto(&scene.model, scene.basis, &scene.method, auto)
-                .map_err(|e| Failure {
-                    code: super::exit_code(&e),
-                    error: anyhow::Error::new(e).context(scene.file.clone()),
-                })?;
+                .map_err(|e| super::failure(e, &scene.file))?;
             solve_seconds = started.elapsed().as_secs_f64();
             (
                 a.solution,
@@ -79,10 +76,10 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
                 .with_context(|| scene.file.clone())?;
             let mut ws = hb.workspace();
-            let sol =
-                scene
-                    .method
-                    .solve(&hb, start.as_ref().map(|s| s.harmonics.as_slice()), &mut ws)?;
+            let sol = scene
+                .method
+                .solve(&hb, start.as_ref().map(|s| s.harmonics.as_slice()), &mut ws)
+                .map_err(|e| super::failure(e, &scene.file))?;
             solve_seconds = started.elapsed().as_secs_f64();
             // The error of the harmonics, against the solution with 2H (module
             // hbal::solve::accuracy); none for an unconverged iterate.
@@ -296,16 +293,15 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             ),
             prefix,
         };
-        write_outputs(dir, &sol, &label, order)?;
+        let mut written = write_outputs(dir, &sol, &label, order)
+            .with_context(|| format!("--out: cannot write {}", dir.display()))?;
         if let Ok(e) = &elements {
             element_report::write_csv(&dir.join(format!("{prefix}elements.csv")), e, order)
                 .with_context(|| format!("--out: cannot write {}", dir.display()))?;
+            written.insert(1, format!("{prefix}elements.csv"));
         }
         if !as_json {
-            say!(
-                "  wrote {prefix}harmonics.csv, {prefix}elements.csv, {prefix}time_series.csv, {prefix}time_series.svg, {prefix}spectrum.svg to {}",
-                dir.display()
-            );
+            say!("  wrote {} to {}", written.join(", "), dir.display());
         }
     }
     let stability_failed = matches!(stability, Some(Err(_)));

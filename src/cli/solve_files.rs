@@ -18,7 +18,7 @@ pub(crate) fn write_outputs(
     sol: &Solution,
     label: &OutputLabel,
     order: impl Fn(usize) -> f64,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<Vec<String>> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let file = |name: &str| dir.join(format!("{}{name}", label.prefix));
     let h = sol.basis().harmonics();
@@ -38,6 +38,7 @@ pub(crate) fn write_outputs(
         }
     }
     w.flush()?;
+    let mut written = vec![format!("{}harmonics.csv", label.prefix)];
     let points = sol.basis().samples().max(256);
     let period = sol.basis().period();
     let series: Vec<Vec<f64>> = (0..sol.dof_names().len())
@@ -57,6 +58,12 @@ pub(crate) fn write_outputs(
         w.write_record(&row)?;
     }
     w.flush()?;
+    written.push(format!("{}time_series.csv", label.prefix));
+    // A plot that cannot be drawn is a warning: the solve and its CSV files stand.
+    let mut plotted = |name: &str, result: Result<(), Box<dyn std::error::Error>>| match result {
+        Ok(()) => written.push(format!("{}{name}", label.prefix)),
+        Err(e) => eprintln!("warning: {name}: {e}"),
+    };
     let (shown, note) = plotted_dofs(sol, h);
     let names = sol.dof_names();
     let lines: Vec<Series> = shown
@@ -72,14 +79,16 @@ pub(crate) fn write_outputs(
             )
         })
         .collect();
-    line_plot(
-        &file("time_series.svg"),
-        &format!("{}: one period{note}", label.title),
-        &Axis::linear("t (s)"),
-        &Axis::linear("q (rad or m)"),
-        &lines,
-    )
-    .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    plotted(
+        "time_series.svg",
+        line_plot(
+            &file("time_series.svg"),
+            &format!("{}: one period{note}", label.title),
+            &Axis::linear("t (s)"),
+            &Axis::linear("q (rad or m)"),
+            &lines,
+        ),
+    );
     // Amplitudes below 1e-13 of the largest are rounding noise: left out.
     let largest = shown
         .iter()
@@ -98,20 +107,23 @@ pub(crate) fn write_outputs(
             )
         })
         .collect();
-    if h > 0 {
-        line_plot(
-            &file("spectrum.svg"),
-            &format!(
-                "{}: amplitude spectrum (static part omitted){note}",
-                label.title
+    // A static solution (every harmonic k >= 1 zero) has no spectrum to plot.
+    if h > 0 && largest > 0.0 {
+        plotted(
+            "spectrum.svg",
+            line_plot(
+                &file("spectrum.svg"),
+                &format!(
+                    "{}: amplitude spectrum (static part omitted){note}",
+                    label.title
+                ),
+                &Axis::linear("harmonic k"),
+                &Axis::log("|q_k| (rad or m)"),
+                &spectra,
             ),
-            &Axis::linear("harmonic k"),
-            &Axis::log("|q_k| (rad or m)"),
-            &spectra,
-        )
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        );
     }
-    Ok(())
+    Ok(written)
 }
 
 /// Most DOFs a plot shows (a legend of a thousand names hides the data).

@@ -68,10 +68,11 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             / per
     });
     for (name, v) in [("--from", from), ("--to", to)] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(
-                anyhow::anyhow!("{name} must be a finite speed > 0 ({unit}), got {v}").into(),
-            );
+        if !(v.is_finite() && v > 0.0 && hbal::error::in_magnitude_range(v * per)) {
+            return Err(anyhow::anyhow!(
+                "{name} must be a finite speed > 0 ({unit}) whose fundamental is within 1e-100 to 1e100 rad/s, got {v:e}"
+            )
+            .into());
         }
     }
     if !(max_step.is_finite() && max_step > 0.0) {
@@ -107,12 +108,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         .with_context(|| scene.file.clone())?;
     // Automatic harmonics: H chosen at the first speed, then kept along the branch.
     if let Some(auto) = scene.auto {
-        let a = hbal::solve::solve_auto(&scene.model, basis, &scene.method, auto).map_err(|e| {
-            Failure {
-                code: super::exit_code(&e),
-                error: anyhow::Error::new(e).context(scene.file.clone()),
-            }
-        })?;
+        let a = hbal::solve::solve_auto(&scene.model, basis, &scene.method, auto)
+            .map_err(|e| super::failure(e, &scene.file))?;
         basis = *a.solution.basis();
         eprintln!(
             "note: harmonics: auto, tolerance {:.0e}: H = {} (error estimate {:.1e} at {from} {unit}{}), kept along the branch",
@@ -154,19 +151,13 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         start.as_ref().map(|s| s.harmonics.as_slice()),
         |f| bar.set_position((f * 1000.0) as u64),
     )
-    .map_err(|e| Failure {
-        code: super::exit_code(&e),
-        error: anyhow::Error::new(e).context(scene.file.clone()),
-    })?;
+    .map_err(|e| super::sweep_failure(e, &scene.file))?;
     let (lo, hi) = (from.min(to) * per, from.max(to) * per);
     let secondary = if opts.all_branches {
         bar.set_message("switching branches");
         continuation
             .switch_branches(&scene.model, basis, &branch, lo, hi)
-            .map_err(|e| Failure {
-                code: super::exit_code(&e),
-                error: anyhow::Error::new(e).context(scene.file.clone()),
-            })?
+            .map_err(|e| super::sweep_failure(e, &scene.file))?
     } else {
         Vec::new()
     };
@@ -326,7 +317,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                     &format!("speed ({unit})"),
                     speed,
                 )
-                .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+                .unwrap_or_else(super::plot_warning);
             }
         }
     }
