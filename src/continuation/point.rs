@@ -53,6 +53,21 @@ impl Continuation {
             // Laws with memory: stability unknown (see FloquetOptions::compute), the branch goes on.
             Some(_) if model.memory_element().is_some() => (None, None),
             Some(options) => match options.compute(model, &sol) {
+                // A non-finite multiplier would reach the outputs as NaN or `null`: it ends
+                // the branch here, named, instead.
+                Ok(f)
+                    if !f
+                        .multipliers
+                        .iter()
+                        .all(|m| m.re.is_finite() && m.im.is_finite()) =>
+                {
+                    (
+                        None,
+                        Some(format!(
+                            "stability at Ω = {omega}: non-finite Floquet multiplier"
+                        )),
+                    )
+                }
                 Ok(f) => (Some(f), None),
                 Err(e) => (None, Some(format!("stability at Ω = {omega}: {e}"))),
             },
@@ -73,7 +88,8 @@ impl Continuation {
             .error_estimate
             .then(|| crate::solve::estimate_error(model, &sol).ok())
             .flatten()
-            .map(|e| e.relative);
+            .map(|e| e.relative)
+            .filter(|e| e.is_finite());
         branch.points.push(BranchPoint {
             parameter: p.parameter,
             omega,
