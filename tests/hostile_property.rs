@@ -1,5 +1,5 @@
 //! Property-based test of hostile input (issue 13): the example scenes, mutated at random, never
-//! make `hbal check` or `hbal solve --json` panic, abort, exceed the time and memory limits, print
+//! make `hbal check`, `hbal solve --json` or `hbal solve --out` panic, abort, exceed the time and memory limits, print
 //! a non-finite number (`null`), or give an exit code that contradicts its JSON (see
 //! `common/hostile.rs` for the judgement).
 //!
@@ -272,6 +272,11 @@ fn mutated_scenes_keep_the_exit_code_contract() {
             solve.extend(["--method", method]);
         }
         commands.push((solve, true));
+        // With --out: the CSV files and plots of whatever solved (a static or odd solution
+        // must not turn into a plot error).
+        let out_dir = dir.join("out");
+        let out_dir = out_dir.to_str().unwrap_or("out");
+        commands.push((vec!["solve", file.as_str(), "--out", out_dir], false));
         let mut t = tally.lock().expect("tally");
         t.cases += 1;
         for (args, json) in commands {
