@@ -274,7 +274,7 @@ fn meaningless_fields_are_refused_with_their_path() {
         &duffing,
         &["sweep", "{}", "--to", "-1"],
         2,
-        "--to must be a finite speed > 0 (rad_s), got -1",
+        "--to must be a finite speed > 0 (rad_s) whose fundamental is within 1e-100 to 1e100 rad/s, got -1",
     );
     // A whole-number field takes whole values ...
     let count_sweep = |points| {
@@ -376,14 +376,14 @@ fn library_non_finite_errors_name_the_place() {
 }
 
 /// A parameter sweep that meets an undamped resonance keeps its points and exits 1; an
-/// unusable `--out` is refused before the sweep (exit 2); a DOF name with `/` stays inside
-/// `--out`.
+/// unusable `--out` is refused before the sweep (exit 2). (A DOF name that cannot be part of a
+/// file name is refused: tests/report.rs.)
 #[test]
 fn parameter_sweep_failures_are_honest() {
-    let undamped = "dofs = [\"x/1\"]\nmass = [[1.0]]\nstiffness = [[1.0]]\n\
+    let undamped = "dofs = [\"x1\"]\nmass = [[1.0]]\nstiffness = [[1.0]]\n\
                     fundamental = { rad_s = 0.6 }\nharmonics = { count = 3 }\n\
-                    loads = [{ dof = \"x/1\", order = 1, cos = 0.1 }]\n[[elements]]\n\
-                    name = \"s\"\ntype = \"cubic_spring\"\nconnects = { \"x/1\" = 1.0 }\n\
+                    loads = [{ dof = \"x1\", order = 1, cos = 0.1 }]\n[[elements]]\n\
+                    name = \"s\"\ntype = \"cubic_spring\"\nconnects = { \"x1\" = 1.0 }\n\
                     k = 0.0\nalpha = 0.1\n";
     let dir = temp_dir();
     let out = dir.join("out");
@@ -415,7 +415,7 @@ fn parameter_sweep_failures_are_honest() {
         "{}",
         run.stdout
     );
-    assert!(dir.join("out/parameter_response_x_1.svg").is_file());
+    assert!(dir.join("out/parameter_response_x1.svg").is_file());
     let blocked = dir.join("undamped.toml");
     let blocked = format!("{}/sub", blocked.display());
     let mut args = sweep;
@@ -425,7 +425,7 @@ fn parameter_sweep_failures_are_honest() {
         undamped,
         &args,
         2,
-        "--out: cannot write to",
+        "cannot create the directory",
     );
     assert!(run.stdout.is_empty(), "{}", run.stdout);
     let _ = std::fs::remove_dir_all(temp_dir());

@@ -70,7 +70,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     for (name, v) in [("--from", from), ("--to", to)] {
         if !(v.is_finite() && v > 0.0 && hbal::error::in_magnitude_range(v * per)) {
             return Err(anyhow::anyhow!(
-                "{name} must be a finite speed > 0 ({unit}) whose fundamental is within 1e-100 to 1e100 rad/s, got {v:e}"
+                "{name} must be a finite speed > 0 ({unit}) whose fundamental is within 1e-100 to 1e100 rad/s, got {}",
+                hbal::report::significant(v, 6)
             )
             .into());
         }
