@@ -305,6 +305,12 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         }
     }
     let stability_failed = matches!(stability, Some(Err(_)));
+    if !sol.is_converged() {
+        eprintln!(
+            "error: {}: the solve did not converge: {}",
+            scene.file, sol.termination
+        );
+    }
     let capped = matches!(&auto, Some((_, _, true)));
     if let Some((a, levels, true)) = &auto {
         eprintln!(
