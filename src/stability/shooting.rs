@@ -3,9 +3,10 @@
 //! (projected onto the coordinates), then the multipliers of `Φ` without its neutral block.
 
 use super::dopri::Stepper;
+use super::exponential::ExpFlow;
 use super::flow::{Flow, FlowOptions};
 use super::system::Coordinates;
-use super::{eigenvalues, neutral, Floquet, FloquetOptions};
+use super::{affine, eigenvalues, neutral, Floquet, FloquetOptions, Integrator};
 use crate::error::{Error, Result};
 use crate::solution::Solution;
 use nalgebra::{DMatrix, DVector};
@@ -34,14 +35,34 @@ pub(crate) fn shoot(
         }
         out
     };
-    let (scale_q, omega_max) = scales(sys, solution, &harmonics);
+    let (scale_q, omega_max, amplitudes) = scales(sys, solution, &harmonics);
     let scale_v = scale_q * omega_max;
-    let mut flow = Flow::new(sys, omega, scale_q, scale_v, options.rtol)?;
-    let opts = FlowOptions {
-        rtol: options.rtol,
-        h_max: 1.0 / omega_max,
-        max_steps: options.max_steps,
+    let runge_kutta = || -> Result<Integration> {
+        Ok(Integration::RungeKutta {
+            flow: Flow::new(sys, omega, scale_q, scale_v, options.rtol)?,
+            stepper: Stepper::new(2 * sys.len() * (1 + 2 * sys.len())),
+            opts: FlowOptions {
+                rtol: options.rtol,
+                h_max: 1.0 / omega_max,
+                max_steps: options.max_steps,
+            },
+        })
     };
+    let mut flow = if options.integrator == Integrator::Auto
+        && affine::piecewise_affine(sys.model, &amplitudes)
+    {
+        Integration::Exponential(ExpFlow::new(
+            sys,
+            omega,
+            scale_q,
+            scale_v,
+            omega_max,
+            options.max_steps,
+        )?)
+    } else {
+        runge_kutta()?
+    };
+    let mut earlier_steps = 0;
     let s2 = 2 * n;
     let scale = |i: usize| if i < n { scale_q } else { scale_v };
     // The HB state at t = 0 in the model's DOFs and in these coordinates.
@@ -59,8 +80,7 @@ pub(crate) fn shoot(
     let rigid = neutral::rigid_body_modes(sys);
     let (positions, all) = neutral::state_bases(&rigid);
     let free_positions = neutral::complement(&positions, s2);
-    let mut stepper = Stepper::new(flow.len());
-    let mut y = vec![0.0; flow.len()];
+    let mut y = vec![0.0; s2 * (1 + s2)];
     let mut phi = DMatrix::<f64>::zeros(s2, s2);
     let mut polished = false;
     let mut last_residual = f64::INFINITY;
@@ -72,8 +92,15 @@ pub(crate) fn shoot(
             y[s2 + i * s2 + i] = 1.0;
         }
         // A period-multiplied orbit: ν excitation periods (the system is T-periodic).
+        let mut affine = true;
         for _ in 0..solution.basis().subharmonic() {
-            flow.period(&mut y, &opts, &mut stepper)?;
+            affine = affine && flow.period(&mut y)?;
+        }
+        if !affine {
+            // A law bent inside a piece: the Runge–Kutta flow from the same start.
+            earlier_steps += flow.steps();
+            flow = runge_kutta()?;
+            continue;
         }
         phi.copy_from_slice(&y[s2..]);
         if phi.iter().any(|v| !v.is_finite()) {
@@ -153,16 +180,53 @@ pub(crate) fn shoot(
         orbit_correction,
         polished,
         orbit_start,
-        steps: flow.steps,
+        steps: earlier_steps + flow.steps(),
         reduction: None,
     })
 }
 
-/// `(s_q, ω_max)` in the coordinates `sys`: the largest coordinate of the orbit (1 if it is
-/// zero) and the fastest angular frequency along it,
+/// The flow over a period: exponentials or Runge–Kutta.
+enum Integration<'c, 'm> {
+    RungeKutta {
+        flow: Flow<'c, 'm>,
+        stepper: Stepper,
+        opts: FlowOptions,
+    },
+    Exponential(ExpFlow<'c, 'm>),
+}
+
+impl Integration<'_, '_> {
+    /// One period of `y = (q, q̇, Φ̃)`; `Ok(false)` if the exponential flow met a law that is
+    /// not affine on its piece.
+    fn period(&mut self, y: &mut [f64]) -> Result<bool> {
+        match self {
+            Integration::RungeKutta {
+                flow,
+                stepper,
+                opts,
+            } => flow.period(y, opts, stepper).map(|()| true),
+            Integration::Exponential(flow) => flow.period(y),
+        }
+    }
+
+    fn steps(&self) -> usize {
+        match self {
+            Integration::RungeKutta { flow, .. } => flow.steps,
+            Integration::Exponential(flow) => flow.steps,
+        }
+    }
+}
+
+/// `(s_q, ω_max, amplitudes)` in the coordinates `sys`: the largest coordinate of the orbit (1
+/// if it is zero), the fastest angular frequency along it,
 /// `max(Ω, sqrt(λ_max(M⁻¹K(t))) + λ_max(M⁻¹D(t))/2)` over the HB samples, which also limits
-/// the integrator's step to `1/ω_max`. `harmonics` are the orbit's in these coordinates.
-fn scales(sys: &Coordinates, solution: &Solution, harmonics: &[Complex64]) -> (f64, f64) {
+/// the integrator's step to `1/ω_max`, and the largest `(|u_e|, |u̇_e|)` of every element.
+/// `harmonics` are the orbit's in these coordinates.
+fn scales(
+    sys: &Coordinates,
+    solution: &Solution,
+    harmonics: &[Complex64],
+) -> (f64, f64, Vec<(f64, f64)>) {
     let n = sys.len();
     let omega = solution.basis().omega();
     let samples = solution.basis().samples().max(16);
@@ -178,8 +242,10 @@ fn scales(sys: &Coordinates, solution: &Solution, harmonics: &[Complex64]) -> (f
     let mut k_max = sys.stiffness.clone();
     let mut d_max = sys.damping.clone();
     let (mut q, mut v) = (vec![0.0; n], vec![0.0; n]);
+    let mut amplitudes = Vec::with_capacity(sys.weights.len());
     for (ei, e) in sys.model.elements().iter().enumerate() {
         let (mut km, mut dm) = (0.0_f64, 0.0_f64);
+        let (mut au, mut adu) = (0.0_f64, 0.0_f64);
         for j in 0..samples {
             // The shaft angle Ωt at sample j (ν times the fundamental's).
             let theta = std::f64::consts::TAU
@@ -189,12 +255,14 @@ fn scales(sys: &Coordinates, solution: &Solution, harmonics: &[Complex64]) -> (f
                 q[i] = series[i][j];
                 v[i] = rates[i][j];
             }
-            let (k, d) = e
-                .law()
-                .derivatives(theta, sys.gather(ei, &q), sys.gather(ei, &v));
+            let (u, du) = (sys.gather(ei, &q), sys.gather(ei, &v));
+            let (k, d) = e.law().derivatives(theta, u, du);
             km = km.max(k.abs());
             dm = dm.max(d.abs());
+            au = au.max(u.abs());
+            adu = adu.max(du.abs());
         }
+        amplitudes.push((au, adu));
         let mean = e.linear_part();
         for &(i, wi) in &sys.weights[ei] {
             for &(j, wj) in &sys.weights[ei] {
@@ -219,7 +287,7 @@ fn scales(sys: &Coordinates, solution: &Solution, harmonics: &[Complex64]) -> (f
             }
         }
     }
-    (scale_q, omega_max)
+    (scale_q, omega_max, amplitudes)
 }
 
 /// `(q_i(θ_j), q̇_i(θ_j))` of the `n` coordinates with `harmonics` (harmonic-major) at
