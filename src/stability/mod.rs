@@ -74,7 +74,7 @@ use crate::solution::Solution;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
-pub use dispatch::{FloquetMethod, Reduction};
+pub use dispatch::{FloquetCache, FloquetMethod, Reduction};
 
 /// A multiplier counts as outside the unit circle once its modulus exceeds `1 + margin`.
 pub const STABILITY_MARGIN: f64 = 1e-6;

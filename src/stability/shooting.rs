@@ -12,12 +12,48 @@ use crate::solution::Solution;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
+/// Where the shooting starts.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Start<'a> {
+    /// The HB state at `t = 0`.
+    Hb,
+    /// The HB state plus a correction `(δq, δq̇)` in the model's DOFs (a sweep's previous
+    /// point's correction).
+    Corrected(&'a [f64]),
+    /// A state `(q, q̇)` in the model's DOFs (the exact orbit on another basis).
+    State(&'a [f64]),
+}
+
+/// When the shooting stops.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Goal<'a> {
+    /// At the exact periodic orbit (scaled residual below `10 rtol`).
+    Exact,
+    /// The comparison of the reduction's estimate: once the change of the multipliers that
+    /// the next Newton step `δ̃` would bring, predicted as `κ ‖δ̃‖∞` with the sensitivity `κ`
+    /// measured by the first analysis, is below 1 % of their distance to `reference`.
+    Compare {
+        reference: &'a [Complex64],
+        kappa: f64,
+    },
+}
+
+/// A Floquet analysis and the sensitivity of its multipliers to the orbit's start: `κ` =
+/// the [`distance`] between the multipliers of the first two shooting iterations over the
+/// first Newton step (`None` if the first period was already converged).
+pub(crate) struct Shot {
+    pub(crate) floquet: Floquet,
+    pub(crate) kappa: Option<f64>,
+}
+
 /// The Floquet analysis of `solution` in the coordinates `sys`.
 pub(crate) fn shoot(
     sys: &Coordinates,
     solution: &Solution,
     options: &FloquetOptions,
-) -> Result<Floquet> {
+    start: Start,
+    goal: Goal,
+) -> Result<Shot> {
     let n_model = sys.model.n_dofs();
     let n = sys.len();
     let omega = solution.basis().omega();
@@ -75,11 +111,25 @@ pub(crate) fn shoot(
             what: "initial state of the Floquet analysis".into(),
         });
     }
-    let mut x0 = sys.project(&x_hb[..n_model]);
-    x0.extend(sys.project(&x_hb[n_model..]));
+    let usable = |s: &[f64]| s.len() == 2 * n_model && s.iter().all(|v| v.is_finite());
+    let from: Vec<f64> = match start {
+        Start::Corrected(d) if usable(d) => x_hb.iter().zip(d).map(|(a, b)| a + b).collect(),
+        Start::State(s) if usable(s) => s.to_vec(),
+        _ => x_hb.clone(),
+    };
+    let mut x0 = sys.project(&from[..n_model]);
+    x0.extend(sys.project(&from[n_model..]));
     let rigid = neutral::rigid_body_modes(sys);
     let (positions, all) = neutral::state_bases(&rigid);
     let free_positions = neutral::complement(&positions, s2);
+    // The multipliers of Φ̃ without its neutral block.
+    let w = (all.ncols() > 0).then(|| neutral::complement(&all, s2));
+    let multipliers_of = |phi: &DMatrix<f64>| match &w {
+        None => eigenvalues(phi),
+        Some(w) => eigenvalues(&(w.transpose() * phi * w)),
+    };
+    let mut first: Option<(Vec<Complex64>, f64)> = None;
+    let mut kappa = None;
     let mut y = vec![0.0; s2 * (1 + s2)];
     let mut phi = DMatrix::<f64>::zeros(s2, s2);
     let mut polished = false;
@@ -111,6 +161,9 @@ pub(crate) fn shoot(
         // Scaled shooting residual r̃ = S⁻¹ (φ_T(x₀) - x₀).
         let r = DVector::from_fn(s2, |i, _| (y[i] - x0[i]) / scale(i));
         let res = r.amax();
+        if let (1, Some((mu, step))) = (iteration, &first) {
+            kappa = Some(distance(mu, &multipliers_of(&phi)) / step);
+        }
         // Converged to the integration noise, or Newton has stalled there.
         if res <= 10.0 * options.rtol {
             polished = true;
@@ -130,6 +183,15 @@ pub(crate) fn shoot(
             break;
         };
         let delta = &free_positions * z;
+        let step = delta.amax();
+        if iteration == 1 && matches!(goal, Goal::Exact) {
+            first = Some((multipliers_of(&phi), step));
+        }
+        if let Goal::Compare { reference, kappa } = goal {
+            if kappa * step <= 0.01 * distance(reference, &multipliers_of(&phi)) {
+                break;
+            }
+        }
         for i in 0..s2 {
             x0[i] += delta[i] * scale(i);
         }
@@ -160,12 +222,7 @@ pub(crate) fn shoot(
     let orbit_correction = (0..2 * n_model)
         .map(|i| (orbit_start[i] - x_hb[i]).abs() / full_scale(i))
         .fold(0.0, f64::max);
-    let multipliers = if all.ncols() == 0 {
-        eigenvalues(&phi)
-    } else {
-        let w = neutral::complement(&all, s2);
-        eigenvalues(&(w.transpose() * &phi * &w))
-    };
+    let multipliers = multipliers_of(&phi);
     if multipliers
         .iter()
         .any(|m| !(m.re.is_finite() && m.im.is_finite()))
@@ -174,15 +231,37 @@ pub(crate) fn shoot(
             what: "Floquet multipliers".into(),
         });
     }
-    Ok(Floquet {
-        multipliers,
-        neutral: all.ncols(),
-        orbit_correction,
-        polished,
-        orbit_start,
-        steps: earlier_steps + flow.steps(),
-        reduction: None,
+    Ok(Shot {
+        floquet: Floquet {
+            multipliers,
+            neutral: all.ncols(),
+            orbit_correction,
+            polished,
+            orbit_start,
+            steps: earlier_steps + flow.steps(),
+            reduction: None,
+        },
+        kappa,
     })
+}
+
+/// The larger of `max_i min_j |a_i - b_j|` over the leading `a_i` and the same over the
+/// leading `b_j`, leading meaning a modulus at least half the largest of both sets (at most 8
+/// from each): a multiplier that only one basis has counts with its distance to the other's
+/// nearest.
+pub(crate) fn distance(a: &[Complex64], b: &[Complex64]) -> f64 {
+    let top = a
+        .first()
+        .map_or(0.0, |m| m.norm())
+        .max(b.first().map_or(0.0, |m| m.norm()));
+    let one_way = |a: &[Complex64], b: &[Complex64]| {
+        a.iter()
+            .take(8)
+            .filter(|m| m.norm() >= 0.5 * top)
+            .map(|m| b.iter().map(|o| (m - o).norm()).fold(m.norm(), f64::min))
+            .fold(0.0, f64::max)
+    };
+    one_way(a, b).max(one_way(b, a))
 }
 
 /// The flow over a period: exponentials or Runge–Kutta.
