@@ -3,14 +3,13 @@
 //! modes below a cut-off plus attachment modes, `2(r + a) × 2(r + a)` whatever n), and the
 //! reduction's accuracy estimate.
 
-use super::reduction::reduced_basis;
-use super::shooting::shoot;
+use super::reduction::{reduced_basis, ModeCache};
+use super::shooting::{distance, shoot, Goal, Shot, Start};
 use super::system::Coordinates;
 use super::{Floquet, FloquetOptions};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solution::Solution;
-use num_complex::Complex64;
 
 /// How [`FloquetOptions::compute`] forms the monodromy matrix.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -77,6 +76,18 @@ impl FloquetOptions {
 
     /// The multipliers of the periodic orbit of `model` next to `solution`.
     pub fn compute(&self, model: &Model, solution: &Solution) -> Result<Floquet> {
+        self.compute_with(model, solution, &mut FloquetCache::default())
+    }
+
+    /// As [`FloquetOptions::compute`], reusing what `cache` kept from earlier analyses of the
+    /// same model (a sweep's points): the undamped modes of `(K0, M)` (which do not depend on
+    /// the speed) and the previous point's orbit correction as the shooting's start.
+    pub fn compute_with(
+        &self,
+        model: &Model,
+        solution: &Solution,
+        cache: &mut FloquetCache,
+    ) -> Result<Floquet> {
         if !(self.rtol > 1e-15 && self.rtol < 1e-2) {
             return Err(Error::invalid(
                 "floquet",
@@ -109,23 +120,66 @@ impl FloquetOptions {
                 got: format!("{} DOFs", solution.dof_names().len()),
             });
         }
-        match self.method.resolve(model) {
-            FloquetMethod::Reduced => self.reduced(model, solution),
+        let (sys, reduction) = match self.method.resolve(model) {
+            FloquetMethod::Reduced => {
+                let (sys, info) = self.reduced_coordinates(model, solution, cache)?;
+                (sys, Some(info))
+            }
             _ => {
                 // The monodromy matrix is dense (2n × 2n): refuse what would not fit.
                 model.dense("stability (Floquet multipliers, dense method)")?;
-                shoot(&Coordinates::full(model), solution, self)
+                (Coordinates::full(model), None)
+            }
+        };
+        let omega = solution.basis().omega();
+        // Start from the previous point's correction if it is near; from the HB state if
+        // that fails to converge.
+        let mut shot = None;
+        if let Some((w, d)) = &cache.correction {
+            if (omega - w).abs() <= 0.2 * w && d.len() == 2 * n {
+                let s = shoot(&sys, solution, self, Start::Corrected(d), Goal::Exact)?;
+                if s.floquet.polished {
+                    shot = Some(s);
+                }
             }
         }
+        let Shot { mut floquet, kappa } = match shot {
+            Some(s) => s,
+            None => shoot(&sys, solution, self, Start::Hb, Goal::Exact)?,
+        };
+        cache.kappa = kappa.or(cache.kappa);
+        cache.correction = floquet.polished.then(|| {
+            let x_hb = (0..n)
+                .map(|i| solution.displacement(i, 0.0))
+                .chain((0..n).map(|i| solution.velocity(i, 0.0)));
+            let d = floquet.orbit_start.iter().zip(x_hb).map(|(a, b)| a - b);
+            (omega, d.collect())
+        });
+        if let Some(mut info) = reduction {
+            if info.dofs >= n {
+                info.estimate = Some(0.0);
+            }
+            floquet.reduction = Some(info);
+            if self.estimate {
+                self.add_estimate(model, solution, &mut floquet, cache)?;
+            }
+        }
+        Ok(floquet)
     }
 
-    /// On the reduced basis with the cut-off `cutoff · H Ω/ν`, and the estimate.
-    fn reduced(&self, model: &Model, solution: &Solution) -> Result<Floquet> {
-        let n = model.n_dofs();
+    /// The coordinates of the reduced basis with the cut-off `cutoff · H Ω/ν` (the modes
+    /// computed up to twice that if the estimate is asked for, so that its basis finds them).
+    fn reduced_coordinates<'m>(
+        &self,
+        model: &'m Model,
+        solution: &Solution,
+        cache: &mut FloquetCache,
+    ) -> Result<(Coordinates<'m>, Reduction)> {
         let top = solution.basis().harmonics() as f64 * solution.basis().fundamental();
         let cutoff = self.cutoff * top;
-        let basis = reduced_basis(model, cutoff)?;
-        let mut info = Reduction {
+        let reach = 2.0 * cutoff;
+        let basis = reduced_basis(model, cutoff, reach, &mut cache.modes)?;
+        let info = Reduction {
             dofs: basis.v.ncols(),
             modes: basis.modes,
             attachment: basis.attachment,
@@ -133,45 +187,61 @@ impl FloquetOptions {
             estimate: None,
             comparison_dofs: None,
         };
-        let mut floquet = shoot(&Coordinates::reduced(model, basis.v), solution, self)?;
-        if info.dofs >= n {
-            info.estimate = Some(0.0);
-        } else if self.estimate {
-            // Twice the cut-off, doubled again (up to 2⁸ times) while that adds no vector.
-            let mut wider = 2.0 * cutoff;
-            let mut larger = reduced_basis(model, wider)?;
-            for _ in 0..7 {
-                if larger.v.ncols() > info.dofs {
-                    break;
-                }
-                wider *= 2.0;
-                larger = reduced_basis(model, wider)?;
-            }
-            info.comparison_dofs = Some(larger.v.ncols());
-            let reference = shoot(&Coordinates::reduced(model, larger.v), solution, self)?;
-            info.estimate = Some(distance(&floquet.multipliers, &reference.multipliers));
-            floquet.steps += reference.steps;
+        Ok((Coordinates::reduced(model, basis.v), info))
+    }
+
+    /// Adds the reduction's estimate to `floquet` (an analysis of `solution` on the reduced
+    /// basis with the options' cut-off): the [`distance`] of its leading multipliers to those on
+    /// the basis with twice the cut-off (doubled again, up to 2⁸ times, while that adds no
+    /// vector), whose shooting starts from `floquet`'s exact orbit and stops once its
+    /// multipliers are known to 1 % of that distance ([`Goal::Compare`], with the sensitivity
+    /// of the last analysis kept in `cache`). Nothing for a dense analysis.
+    pub(crate) fn add_estimate(
+        &self,
+        model: &Model,
+        solution: &Solution,
+        floquet: &mut Floquet,
+        cache: &mut FloquetCache,
+    ) -> Result<()> {
+        let Some(info) = floquet.reduction.as_mut() else {
+            return Ok(());
+        };
+        if info.estimate.is_some() {
+            return Ok(());
         }
-        floquet.reduction = Some(info);
-        Ok(floquet)
+        let mut wider = 2.0 * info.cutoff;
+        let mut larger = reduced_basis(model, wider, wider, &mut cache.modes)?;
+        for _ in 0..7 {
+            if larger.v.ncols() > info.dofs {
+                break;
+            }
+            wider *= 2.0;
+            larger = reduced_basis(model, wider, wider, &mut cache.modes)?;
+        }
+        info.comparison_dofs = Some(larger.v.ncols());
+        let goal = match cache.kappa {
+            Some(kappa) => Goal::Compare {
+                reference: &floquet.multipliers,
+                kappa,
+            },
+            None => Goal::Exact,
+        };
+        let sys = Coordinates::reduced(model, larger.v);
+        let start = Start::State(&floquet.orbit_start);
+        let reference = shoot(&sys, solution, self, start, goal)?.floquet;
+        info.estimate = Some(distance(&floquet.multipliers, &reference.multipliers));
+        floquet.steps += reference.steps;
+        Ok(())
     }
 }
 
-/// The larger of `max_i min_j |a_i - b_j|` over the leading `a_i` and the same over the
-/// leading `b_j`, leading meaning a modulus at least half the largest of both sets (at most 8
-/// from each): a multiplier that only one basis has counts with its distance to the other's
-/// nearest.
-fn distance(a: &[Complex64], b: &[Complex64]) -> f64 {
-    let top = a
-        .first()
-        .map_or(0.0, |m| m.norm())
-        .max(b.first().map_or(0.0, |m| m.norm()));
-    let one_way = |a: &[Complex64], b: &[Complex64]| {
-        a.iter()
-            .take(8)
-            .filter(|m| m.norm() >= 0.5 * top)
-            .map(|m| b.iter().map(|o| (m - o).norm()).fold(m.norm(), f64::min))
-            .fold(0.0, f64::max)
-    };
-    one_way(a, b).max(one_way(b, a))
+/// What a sweep's Floquet analyses keep from one point to the next
+/// ([`FloquetOptions::compute_with`]): the undamped modes of the model, the last orbit
+/// correction (the shooting of the next point starts from the HB state plus it), and the
+/// sensitivity of the multipliers to the orbit measured by the last shooting.
+#[derive(Debug, Clone, Default)]
+pub struct FloquetCache {
+    modes: ModeCache,
+    correction: Option<(f64, Vec<f64>)>,
+    kappa: Option<f64>,
 }

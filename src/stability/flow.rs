@@ -23,27 +23,11 @@
 // Numerical kernels index several arrays in lock step.
 #![allow(clippy::needless_range_loop)]
 
-use super::dopri::{hermite, step_factor, Stepper};
+use super::dopri::{step_factor, Stepper};
+use super::pieces::Pieces;
 use super::system::Coordinates;
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
-
-/// Where each element is relative to its kinks: `side[e] = j` means
-/// `kinks[e][j-1] <= u < kinks[e][j]` (open at the ends).
-struct Pieces {
-    kinks: Vec<Vec<f64>>,
-    side: Vec<usize>,
-}
-
-impl Pieces {
-    fn interval(&self, e: usize) -> (f64, f64) {
-        let k = &self.kinks[e];
-        let j = self.side[e];
-        let lo = if j == 0 { f64::NEG_INFINITY } else { k[j - 1] };
-        let hi = k.get(j).copied().unwrap_or(f64::INFINITY);
-        (lo, hi)
-    }
-}
 
 /// The integration options and counters.
 pub(crate) struct FlowOptions {
@@ -99,22 +83,6 @@ impl<'c, 'm> Flow<'c, 'm> {
                 reason: "Cholesky factorisation failed".into(),
             })?
             .inverse();
-        let kinks = model
-            .elements()
-            .iter()
-            .map(|e| {
-                let mut k: Vec<f64> = e
-                    .law()
-                    .kinks()
-                    .into_iter()
-                    .filter(|v| v.is_finite())
-                    .collect();
-                k.sort_by(f64::total_cmp);
-                k.dedup();
-                k
-            })
-            .collect::<Vec<_>>();
-        let side = vec![0; kinks.len()];
         let len = 2 * n + 4 * n * n;
         let mut atol = vec![rtol; len];
         atol[..n].iter_mut().for_each(|a| *a = rtol * scale_q);
@@ -126,7 +94,7 @@ impl<'c, 'm> Flow<'c, 'm> {
             omega,
             bounds: crate::timesim::segment_bounds(model),
             segment: (0.0, 0.0, 0.0, std::f64::consts::TAU),
-            pieces: Pieces { kinks, side },
+            pieces: Pieces::new(sys),
             scale_q,
             omega_s: scale_v / scale_q,
             atol,
@@ -154,11 +122,6 @@ impl<'c, 'm> Flow<'c, 'm> {
         })
     }
 
-    /// Length of the augmented state.
-    pub(crate) fn len(&self) -> usize {
-        2 * self.n + 4 * self.n * self.n
-    }
-
     fn enter_segment(&mut self, t_a: f64, theta_a: f64, theta_b: f64) {
         let delta = 1e-9 * (theta_b - theta_a);
         self.segment = (t_a, theta_a, theta_a + delta, theta_b - delta);
@@ -166,19 +129,7 @@ impl<'c, 'm> Flow<'c, 'm> {
 
     /// Force and derivatives of element `e` on its current piece at `(θ, u, u̇)`.
     fn element_law(&self, e: usize, theta: f64, u: f64, du: f64) -> (f64, f64, f64) {
-        let law = self.sys.model.elements()[e].law();
-        let (lo, hi) = self.pieces.interval(e);
-        if u > lo && u < hi {
-            let f = law.force(theta, u, du);
-            let (k, d) = law.derivatives(theta, u, du);
-            return (f, k, d);
-        }
-        // Continue the piece linearly from just inside its edge.
-        let edge = if u <= lo { lo } else { hi };
-        let inside = nudge(edge, if u <= lo { 1.0 } else { -1.0 });
-        let f = law.force(theta, inside, du);
-        let (k, d) = law.derivatives(theta, inside, du);
-        (f + k * (u - inside), k, d)
+        self.pieces.law(self.sys, e, theta, u, du)
     }
 
     /// The right-hand side of the augmented state:
@@ -293,18 +244,7 @@ impl<'c, 'm> Flow<'c, 'm> {
     /// Sets each element's piece from the state `(q, q̇)` at the start.
     fn init_pieces(&mut self, y: &[f64]) {
         let n = self.n;
-        for ei in 0..self.sys.weights.len() {
-            let (u, du) = (
-                self.sys.gather(ei, &y[..n]),
-                self.sys.gather(ei, &y[n..2 * n]),
-            );
-            let k = &self.pieces.kinks[ei];
-            // On a kink, the side it is moving to.
-            self.pieces.side[ei] = k
-                .iter()
-                .filter(|&&kv| kv < u || (kv == u && du > 0.0))
-                .count();
-        }
+        self.pieces.init(self.sys, &y[..n], &y[n..2 * n]);
     }
 
     /// The first kink crossing inside the last step `(t, y) → (t + h, y_new)`: `(fraction of
@@ -320,50 +260,12 @@ impl<'c, 'm> Flow<'c, 'm> {
         let n = self.n;
         let mut best: Option<(f64, usize, bool)> = None;
         for ei in 0..self.sys.weights.len() {
-            let (lo, hi) = self.pieces.interval(ei);
-            if lo == f64::NEG_INFINITY && hi == f64::INFINITY {
-                continue;
-            }
             let g = |x: &[f64]| self.sys.gather(ei, &x[..n]);
             let (u0, u1, du0, du1) = (g(y), g(y1), g(f0), g(f1));
-            let tol = 1e-13 * (self.scale_q + lo.abs().min(hi.abs()).min(1e300));
-            let outside = |u: f64| -> Option<bool> {
-                if u >= hi + tol {
-                    Some(true)
-                } else if u <= lo - tol {
-                    Some(false)
-                } else {
-                    None
+            if let Some((s, up)) = self.pieces.crossing(ei, u0, u1, du0, du1, h, self.scale_q) {
+                if best.is_none_or(|(sb, _, _)| s < sb) {
+                    best = Some((s, ei, up));
                 }
-            };
-            const PROBES: usize = 8;
-            let mut prev_s = 0.0;
-            for p in 1..=PROBES {
-                let s = p as f64 / PROBES as f64;
-                let u = if p == PROBES {
-                    u1
-                } else {
-                    hermite(u0, u1, du0, du1, h, s)
-                };
-                if let Some(up) = outside(u) {
-                    // Bisection on the interpolant inside [prev_s, s].
-                    let edge = if up { hi } else { lo };
-                    let (mut a, mut b) = (prev_s, s);
-                    for _ in 0..50 {
-                        let mid = 0.5 * (a + b);
-                        let um = hermite(u0, u1, du0, du1, h, mid);
-                        if (um - edge) * (if up { 1.0 } else { -1.0 }) >= 0.0 {
-                            b = mid;
-                        } else {
-                            a = mid;
-                        }
-                    }
-                    if best.is_none_or(|(sb, _, _)| b < sb) {
-                        best = Some((b, ei, up));
-                    }
-                    break;
-                }
-                prev_s = s;
             }
         }
         best
@@ -510,11 +412,7 @@ impl<'c, 'm> Flow<'c, 'm> {
         let sys = self.sys;
         let (u, du) = (sys.gather(e, &y[..n]), sys.gather(e, &y[n..2 * n]));
         let (f_before, _, _) = self.element_law(e, theta, u, du);
-        if up {
-            self.pieces.side[e] += 1;
-        } else {
-            self.pieces.side[e] -= 1;
-        }
+        self.pieces.cross(e, up);
         let (f_after, _, _) = self.element_law(e, theta, u, du);
         let jump = f_after - f_before;
         let size = f_before.abs().max(f_after.abs());
@@ -539,10 +437,4 @@ impl<'c, 'm> Flow<'c, 'm> {
             }
         }
     }
-}
-
-/// A point just inside a kink at `x`, on the side `direction` (±1).
-fn nudge(x: f64, direction: f64) -> f64 {
-    let step = 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE);
-    x + direction * step
 }

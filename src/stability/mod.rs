@@ -53,12 +53,17 @@
 //! # Ok::<(), hbal::Error>(())
 //! ```
 
+mod affine;
 mod dispatch;
 mod dopri;
+mod expm;
+mod exponential;
 mod flow;
+mod generator;
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
+mod pieces;
 mod reduction;
 mod shooting;
 mod system;
@@ -69,7 +74,7 @@ use crate::solution::Solution;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
-pub use dispatch::{FloquetMethod, Reduction};
+pub use dispatch::{FloquetCache, FloquetMethod, Reduction};
 
 /// A multiplier counts as outside the unit circle once its modulus exceeds `1 + margin`.
 pub const STABILITY_MARGIN: f64 = 1e-6;
@@ -176,6 +181,21 @@ pub struct FloquetOptions {
     /// Estimate the reduction's error by a second analysis on the basis with twice the cut-off
     /// ([`Reduction::estimate`]); costs that analysis. Default `true`.
     pub estimate: bool,
+    /// How the flow over a period is integrated. Default [`Integrator::Auto`].
+    pub integrator: Integrator,
+}
+
+/// The integrator of the orbit and its monodromy matrix over a period.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integrator {
+    /// Exact exponentials of the piecewise constant linearisation where every law is affine
+    /// between its time jumps and kinks (rectangular or constant mesh stiffness, backlash,
+    /// linear springs), Dormand–Prince otherwise.
+    #[default]
+    Auto,
+    /// Dormand–Prince 5(4) with error control (`rtol`) for every model.
+    RungeKutta,
 }
 
 impl Default for FloquetOptions {
@@ -187,6 +207,7 @@ impl Default for FloquetOptions {
             method: FloquetMethod::Auto,
             cutoff: 3.0,
             estimate: true,
+            integrator: Integrator::Auto,
         }
     }
 }

@@ -11,6 +11,9 @@
 //! dropped when they lie in the span already (relative M-norm below 1e-8): with every mode
 //! kept, `V` is square and invertible, and the reduction a similarity transform.
 //!
+//! The modes come from a [`ModeCache`], computed once per model up to a reach (by default
+//! twice the cut-off) and selected below each cut-off.
+//!
 //! The shift `σ = 10⁻⁴ ω_ref²` (`ω_ref` the cut-off, or for every mode the largest
 //! `sqrt(K0_ii / M_ii)`) makes a free-free model's singular `K0` factorisable.
 //!
@@ -18,10 +21,11 @@
 //! multipliers. With structural damping they lie deep inside the unit circle
 //! (`|μ| = e^{-ζ ω T}`); an undamped model's would lie on it and are not reported.
 
-use super::modes::{lowest_modes, DENSE_MODES};
+use super::modes::{lowest_modes, ShiftedStiffness, DENSE_MODES};
 use crate::error::{Error, Result};
-use crate::model::Model;
+use crate::model::{Model, SparseMatrix};
 use nalgebra::{DMatrix, DVector};
+use std::hash::{Hash, Hasher};
 
 /// A reduced basis and what it holds.
 pub(crate) struct Basis {
@@ -33,9 +37,89 @@ pub(crate) struct Basis {
     pub(crate) attachment: usize,
 }
 
+/// The modes of `(K0, M)` computed so far for one model (identified by a hash of `K0` and
+/// `M`): every mode with `ω² <= complete`. The modes do not depend on the speed, so a sweep
+/// computes them once (up to twice the first point's cut-off, which also covers the
+/// estimate's basis) and selects the ones below each point's cut-off.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ModeCache {
+    fingerprint: u64,
+    complete: f64,
+    values: Vec<f64>,
+    vectors: DMatrix<f64>,
+}
+
+impl ModeCache {
+    /// The modes with `ω <= cutoff` of `model` (`k0` its `K0`), computing every mode up to
+    /// `reach >= cutoff` if they are not known yet; `shift` is the factorisation's shift then.
+    fn below(
+        &mut self,
+        model: &Model,
+        k0: &SparseMatrix,
+        cutoff: f64,
+        reach: f64,
+    ) -> Result<(Vec<f64>, DMatrix<f64>)> {
+        let fingerprint = fingerprint(model.mass(), k0);
+        if fingerprint != self.fingerprint || self.complete < cutoff * cutoff {
+            let reach = reach.max(cutoff);
+            let (modes, _) =
+                lowest_modes(k0, model.mass(), reach * reach, shift(model, k0, reach))?;
+            self.fingerprint = fingerprint;
+            // The dense eigenproblem gives every mode.
+            self.complete = if k0.n() <= DENSE_MODES {
+                f64::INFINITY
+            } else {
+                reach * reach
+            };
+            self.values = modes.values;
+            self.vectors = modes.vectors;
+        }
+        let r = self
+            .values
+            .iter()
+            .filter(|&&v| v <= cutoff * cutoff)
+            .count();
+        Ok((
+            self.values[..r].to_vec(),
+            self.vectors.columns(0, r).into_owned(),
+        ))
+    }
+}
+
+/// A hash of the entries of `m` and `k0`.
+fn fingerprint(m: &SparseMatrix, k0: &SparseMatrix) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for a in [m, k0] {
+        a.n().hash(&mut h);
+        for (i, j, v) in a.iter() {
+            (i, j, v.to_bits()).hash(&mut h);
+        }
+    }
+    h.finish()
+}
+
+/// The shift `σ = 10⁻⁴ ω_ref²` of the factorisation for the cut-off `cutoff`.
+fn shift(model: &Model, k0: &SparseMatrix, cutoff: f64) -> f64 {
+    let m = model.mass();
+    let reference = if cutoff.is_finite() {
+        cutoff
+    } else {
+        (0..k0.n())
+            .map(|i| k0.get(i, i) / m.get(i, i))
+            .fold(0.0, f64::max)
+            .sqrt()
+    };
+    1e-4 * reference * reference
+}
+
 /// The basis of the modes with `ω <= cutoff` (rad/s; `f64::INFINITY` for all) and the
-/// attachment modes of `model`.
-pub(crate) fn reduced_basis(model: &Model, cutoff: f64) -> Result<Basis> {
+/// attachment modes of `model`, the modes from `cache` (computed up to `reach` if missing).
+pub(crate) fn reduced_basis(
+    model: &Model,
+    cutoff: f64,
+    reach: f64,
+    cache: &mut ModeCache,
+) -> Result<Basis> {
     let n = model.n_dofs();
     if cutoff.is_infinite() && n > DENSE_MODES.max(Model::MAX_DENSE_DOFS) {
         return Err(Error::invalid(
@@ -49,18 +133,9 @@ pub(crate) fn reduced_basis(model: &Model, cutoff: f64) -> Result<Basis> {
         ));
     }
     let k0 = model.k0();
-    let m = model.mass();
-    let reference = if cutoff.is_finite() {
-        cutoff
-    } else {
-        (0..n)
-            .map(|i| k0.get(i, i) / m.get(i, i))
-            .fold(0.0_f64, f64::max)
-            .sqrt()
-    };
-    let shift = 1e-4 * reference * reference;
-    let (modes, factor) = lowest_modes(&k0, m, cutoff * cutoff, shift)?;
-    let r = modes.values.len();
+    let (values, vectors) = cache.below(model, &k0, cutoff, reach)?;
+    let factor = ShiftedStiffness::new(&k0, model.mass(), shift(model, &k0, cutoff))?;
+    let r = values.len();
     // Unit forces on the element coordinates and the loaded DOFs.
     let mut forces: Vec<Vec<(usize, f64)>> = model
         .elements()
@@ -79,7 +154,7 @@ pub(crate) fn reduced_basis(model: &Model, cutoff: f64) -> Result<Basis> {
         }
     }
     factor.solve_in_place(&mut a);
-    let mut v = modes.vectors;
+    let mut v = vectors;
     let mut kept = 0;
     for c in 0..a.ncols() {
         if v.ncols() >= n {

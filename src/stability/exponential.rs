@@ -1,0 +1,418 @@
+//! The flow over one period by exact exponentials, for models whose laws are affine on every
+//! piece ([`affine`](super::affine)): rectangular or constant mesh stiffness, backlash and stop
+//! contacts, linear springs and dampers.
+//!
+//! Between two time jumps of the laws and two kink crossings every law is
+//! `f_e = f0_e + k_e u + d_e u̇` with constant `(f0_e, k_e, d_e)`, so in the scaled state
+//! `x̃ = (q/s_q, q̇/s_v)` (`ω_s = s_v/s_q`) the equations of motion are linear with constant
+//! coefficients and a trigonometric forcing,
+//!
+//! `x̃' = Ã x̃ + b̃(t)`, `Ã = [[0, ω_s I], [-M⁻¹K/ω_s, -M⁻¹D]]`, `K = K_s + Σ k_e w_e w_eᵀ`,
+//! `D = D_s + Σ d_e w_e w_eᵀ`, `b̃ = [0; M⁻¹(f(t) - Σ f0_e w_e)/s_v]`,
+//!
+//! and the scaled monodromy matrix obeys `Φ̃' = Ã Φ̃`: over a piece of length `h` it is
+//! multiplied by `e^{Ãh}`, whatever the stiffness (the contact modes at 10⁵ rad/s that cap an
+//! explicit step cost nothing here). A period of the drivetrain has about 700 pieces but only
+//! about 40 distinct generators `Ã`; each is kept with its exact sub-step over the flow's
+//! `δ₀ = 2^{-⌈log₂ ω_max⌉}` (`ω_max δ₀ <= 1`, ω_max the fastest frequency along the orbit) and
+//! the ladder `E_δ₀^{2^j}` ([`generator`](super::generator)). A piece `h = m δ₀ + r` costs:
+//!
+//! * the orbit: `m` sub-steps `x̃ ← E_δ₀ x̃ + X_δ₀ z(t)` (`z` the load oscillator), then the
+//!   remainder `r` by the Taylor series of the exact solution,
+//!   `x̃(t+τ) = Σ τⁱ x̃⁽ⁱ⁾/i!`, `x̃⁽ⁱ⁺¹⁾ = Ã x̃⁽ⁱ⁾ + b̃⁽ⁱ⁾(t)`;
+//! * a kink crossing is detected on every sub-step from the cubic Hermite interpolant of `u` as
+//!   in the Runge–Kutta flow and located by Newton on the same Taylor series;
+//! * the monodromy matrix: one product per set bit of `m`, and `e^{Ãτ}` for the last part
+//!   (`τ = r`, or up to the crossing) by the Taylor polynomial from the kept powers; at a
+//!   crossing the saltation matrix of a force jump.
+//!
+//! The laws' coefficients are read at a fixed point inside each kink interval
+//! ([`Pieces::inside`]), so that equal pieces give bit-equal keys. At the end of every piece
+//! each law is evaluated again at the orbit: if its derivatives or its offset have changed (a
+//! law that is not affine after all), the flow reports it and the analysis falls back on the
+//! Runge–Kutta flow.
+
+use super::expm::ExpWork;
+use super::generator::{Forcing, State};
+use super::pieces::Pieces;
+use super::system::Coordinates;
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, DVector};
+use std::collections::HashMap;
+
+/// The flow over one period by exponentials.
+pub(crate) struct ExpFlow<'c, 'm> {
+    sys: &'c Coordinates<'m>,
+    n: usize,
+    omega: f64,
+    bounds: Vec<f64>,
+    pieces: Pieces,
+    scale_q: f64,
+    scale_v: f64,
+    /// The sub-step δ₀ (a power of two).
+    delta0: f64,
+    max_steps: usize,
+    /// `Ã` of the structure alone.
+    base: DMatrix<f64>,
+    /// `M⁻¹ w_e` (unscaled).
+    mw: Vec<DVector<f64>>,
+    forcing: Forcing,
+    work: ExpWork,
+    /// The generators met so far, and their index by the laws' coefficients.
+    states: Vec<State>,
+    index: HashMap<Vec<u64>, usize>,
+    /// Taylor coefficients `x̃⁽ⁱ⁾` of the exact solution from the last expansion point.
+    derivs: Vec<DVector<f64>>,
+    terms: usize,
+    /// Integration steps (sub-steps and remainders) over all periods.
+    pub(crate) steps: usize,
+}
+
+/// A piece: its generator and the laws' coefficients `(f0_e, k_e, d_e)`.
+struct Piece {
+    state: usize,
+    coefficients: Vec<(f64, f64, f64)>,
+}
+
+impl<'c, 'm> ExpFlow<'c, 'm> {
+    /// The flow in `sys` at fundamental `omega`, with state scales `s_q`, `s_v` and the fastest
+    /// frequency `omega_max` along the orbit.
+    pub(crate) fn new(
+        sys: &'c Coordinates<'m>,
+        omega: f64,
+        scale_q: f64,
+        scale_v: f64,
+        omega_max: f64,
+        max_steps: usize,
+    ) -> Result<Self> {
+        let n = sys.len();
+        let m_inv = sys
+            .mass
+            .clone()
+            .cholesky()
+            .ok_or_else(|| Error::MassNotPositiveDefinite {
+                reason: "Cholesky factorisation failed".into(),
+            })?
+            .inverse();
+        let omega_s = scale_v / scale_q;
+        let mut base = DMatrix::zeros(2 * n, 2 * n);
+        for i in 0..n {
+            base[(i, n + i)] = omega_s;
+        }
+        base.view_mut((n, 0), (n, n))
+            .copy_from(&(-(&m_inv * &sys.stiffness) / omega_s));
+        base.view_mut((n, n), (n, n))
+            .copy_from(&(-(&m_inv * &sys.damping)));
+        let mw = sys
+            .weights
+            .iter()
+            .map(|w| {
+                DVector::from_fn(n, |i, _| {
+                    w.iter().map(|&(j, wj)| m_inv[(i, j)] * wj).sum::<f64>()
+                })
+            })
+            .collect();
+        Ok(Self {
+            sys,
+            n,
+            omega,
+            bounds: crate::timesim::segment_bounds(sys.model),
+            pieces: Pieces::new(sys),
+            scale_q,
+            scale_v,
+            delta0: f64::powi(2.0, -(omega_max.max(omega).log2().ceil() as i32)),
+            max_steps,
+            base,
+            mw,
+            forcing: Forcing::new(sys, &m_inv, scale_v, omega),
+            work: ExpWork::new(2 * n),
+            states: Vec::new(),
+            index: HashMap::new(),
+            derivs: Vec::new(),
+            terms: 0,
+            steps: 0,
+        })
+    }
+
+    /// The piece the scaled state `x̃` is in, laws evaluated at angle `theta`.
+    fn piece(&mut self, theta: f64) -> Piece {
+        let n = self.n;
+        let mut coefficients = Vec::with_capacity(self.mw.len());
+        let mut key = Vec::with_capacity(3 * self.mw.len());
+        for e in 0..self.mw.len() {
+            let u = self.pieces.inside(e);
+            let (f, k, d) = self.pieces.law(self.sys, e, theta, u, 0.0);
+            let f0 = f - k * u;
+            coefficients.push((f0, k, d));
+            key.extend([f0.to_bits(), k.to_bits(), d.to_bits()]);
+        }
+        let state = match self.index.get(&key) {
+            Some(&i) => i,
+            None => {
+                let omega_s = self.scale_v / self.scale_q;
+                let mut a = self.base.clone();
+                let mut offset = DVector::zeros(2 * n);
+                for (e, (&(f0, k, d), mw)) in coefficients.iter().zip(&self.mw).enumerate() {
+                    for i in 0..n {
+                        offset[n + i] -= f0 * mw[i] / self.scale_v;
+                    }
+                    for &(j, wj) in &self.sys.weights[e] {
+                        for i in 0..n {
+                            a[(n + i, j)] -= k / omega_s * mw[i] * wj;
+                            a[(n + i, n + j)] -= d * mw[i] * wj;
+                        }
+                    }
+                }
+                let s = State::new(a, offset, &self.forcing, self.delta0, &mut self.work);
+                self.states.push(s);
+                self.index.insert(key, self.states.len() - 1);
+                self.states.len() - 1
+            }
+        };
+        Piece {
+            state,
+            coefficients,
+        }
+    }
+
+    /// `(u, u̇)` of element `e` at the scaled state `x̃`.
+    fn element_state(&self, e: usize, x: &DVector<f64>) -> (f64, f64) {
+        let n = self.n;
+        let sys = self.sys;
+        (
+            self.scale_q * sys.gather(e, &x.as_slice()[..n]),
+            self.scale_v * sys.gather(e, &x.as_slice()[n..]),
+        )
+    }
+
+    /// `true` if every law at `x̃` and `theta` still has the piece's coefficients.
+    fn still_affine(&self, piece: &Piece, x: &DVector<f64>, theta: f64) -> bool {
+        piece
+            .coefficients
+            .iter()
+            .enumerate()
+            .all(|(e, &(f0, k, d))| {
+                let (u, du) = self.element_state(e, x);
+                let (f, k1, d1) = self.pieces.law(self.sys, e, theta, u, du);
+                let close = |a: f64, b: f64, size: f64| (a - b).abs() <= 1e-9 * size;
+                close(k, k1, k.abs().max(k1.abs()))
+                    && close(d, d1, d.abs().max(d1.abs()))
+                    && close(
+                        f,
+                        f0 + k * u + d * du,
+                        f.abs() + f0.abs() + (k * u).abs() + (d * du).abs(),
+                    )
+            })
+    }
+
+    /// Integrates `y = (q, q̇, Φ̃)` over one period `[0, T]`. `Ok(false)`: a law is not affine
+    /// on its piece (`y` is then meaningless; use the Runge–Kutta flow).
+    pub(crate) fn period(&mut self, y: &mut [f64]) -> Result<bool> {
+        let n = self.n;
+        let s2 = 2 * n;
+        let mut x = DVector::from_fn(s2, |i, _| {
+            y[i] / if i < n { self.scale_q } else { self.scale_v }
+        });
+        let mut phi = DMatrix::from_column_slice(s2, s2, &y[s2..]);
+        let (mut e_tau, mut tmp) = (DMatrix::zeros(s2, s2), DMatrix::zeros(s2, s2));
+        let mut z = DVector::zeros(self.forcing.states());
+        let mut x_new = DVector::zeros(s2);
+        self.pieces.init(self.sys, &y[..n], &y[n..s2]);
+        let (omega, delta0) = (self.omega, self.delta0);
+        let bounds = self.bounds.clone();
+        let steps_at_start = self.steps;
+        for w in bounds.windows(2) {
+            let (ta, tb) = (w[0] / omega, w[1] / omega);
+            let margin = 1e-9 * (w[1] - w[0]);
+            let angle = |t: f64| (w[0] + omega * (t - ta)).clamp(w[0] + margin, w[1] - margin);
+            let mut t = ta;
+            while tb - t > 1e-14 * tb.abs().max(1.0 / omega) {
+                let whole = ((tb - t) / delta0).floor();
+                if self.steps - steps_at_start + whole as usize > self.max_steps {
+                    return Err(Error::Solver {
+                        reason: format!(
+                            "Floquet integration needed more than {} steps in one period",
+                            self.max_steps
+                        ),
+                    });
+                }
+                let piece = self.piece(angle(0.5 * (t + tb)));
+                let state = &self.states[piece.state];
+                // Whole sub-steps until a crossing.
+                let mut done = 0;
+                let mut hit = None;
+                for k in 0..whole as usize {
+                    self.forcing.oscillator(t + k as f64 * delta0, &mut z);
+                    x_new.gemv(1.0, state.e0(), &x, 0.0);
+                    x_new.gemv(1.0, &state.x0, &z, 1.0);
+                    hit = self.first_crossing(&x, &x_new, delta0);
+                    if hit.is_some() {
+                        break;
+                    }
+                    std::mem::swap(&mut x, &mut x_new);
+                    done += 1;
+                }
+                let t_sub = t + done as f64 * delta0;
+                // The last part: up to the crossing, or the remainder.
+                let (tau, crossed) = if let Some((s, e, up)) = hit {
+                    self.expand(piece.state, &x, t_sub, delta0);
+                    (
+                        self.locate(&mut x, s * delta0, delta0, e, up),
+                        Some((e, up)),
+                    )
+                } else {
+                    let r = (tb - t_sub).max(0.0);
+                    self.expand(piece.state, &x, t_sub, r);
+                    self.evaluate(r, &mut x_new);
+                    match self.first_crossing(&x, &x_new, r) {
+                        Some((s, e, up)) => (self.locate(&mut x, s * r, r, e, up), Some((e, up))),
+                        None => {
+                            std::mem::swap(&mut x, &mut x_new);
+                            (r, None)
+                        }
+                    }
+                };
+                self.steps += done + 1;
+                // Φ̃ ← e^{Ãτ} E_δ₀^done Φ̃.
+                let state = &mut self.states[piece.state];
+                state.advance(done, &mut phi, &mut tmp);
+                if tau > 0.0 {
+                    self.work.exp(&state.powers, tau, &mut e_tau);
+                    tmp.gemm(1.0, &e_tau, &phi, 0.0);
+                    std::mem::swap(&mut phi, &mut tmp);
+                }
+                let end = if crossed.is_some() { t_sub + tau } else { tb };
+                if !self.still_affine(&piece, &x, angle(end)) {
+                    return Ok(false);
+                }
+                if let Some((e, up)) = crossed {
+                    self.cross(e, up, angle(end), &x, &mut phi);
+                }
+                t = end;
+            }
+        }
+        for i in 0..s2 {
+            y[i] = x[i] * if i < n { self.scale_q } else { self.scale_v };
+        }
+        y[s2..].copy_from_slice(phi.as_slice());
+        if y.iter().any(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "variational equation (exponential flow)".into(),
+            });
+        }
+        Ok(true)
+    }
+
+    /// The earliest kink crossing between the scaled states `x0` and `x1` a time `h` apart:
+    /// `(fraction, element, upwards?)`.
+    fn first_crossing(
+        &self,
+        x0: &DVector<f64>,
+        x1: &DVector<f64>,
+        h: f64,
+    ) -> Option<(f64, usize, bool)> {
+        let mut best: Option<(f64, usize, bool)> = None;
+        for e in 0..self.mw.len() {
+            if !self.pieces.has_kinks(e) {
+                continue;
+            }
+            let (u0, du0) = self.element_state(e, x0);
+            let (u1, du1) = self.element_state(e, x1);
+            if let Some((s, up)) = self.pieces.crossing(e, u0, u1, du0, du1, h, self.scale_q) {
+                if best.is_none_or(|(b, _, _)| s < b) {
+                    best = Some((s, e, up));
+                }
+            }
+        }
+        best
+    }
+
+    /// The Taylor coefficients `x̃⁽ⁱ⁾` at `t` of the exact solution through `x̃` on the piece
+    /// `state`, until their terms over `horizon` are below 1e-18 of the state.
+    fn expand(&mut self, state: usize, x: &DVector<f64>, t: f64, horizon: f64) {
+        let n = self.n;
+        let s = &self.states[state];
+        let mut w = DVector::zeros(self.forcing.states());
+        self.forcing.oscillator(t, &mut w);
+        if self.derivs.is_empty() {
+            self.derivs.push(DVector::zeros(2 * n));
+        }
+        self.derivs[0].copy_from(x);
+        let size = x.amax().max(f64::MIN_POSITIVE);
+        let mut factor = 1.0;
+        self.terms = 1;
+        for i in 0..100 {
+            if self.derivs.len() == i + 1 {
+                self.derivs.push(DVector::zeros(2 * n));
+            }
+            let (done, next) = self.derivs.split_at_mut(i + 1);
+            let next = &mut next[0];
+            next.gemv(1.0, &s.powers.a, &done[i], 0.0);
+            let v = &mut next.as_mut_slice()[n..];
+            self.forcing.add_load(&w, v);
+            if i == 0 {
+                for (o, c) in v.iter_mut().zip(&s.offset.as_slice()[n..]) {
+                    *o += c;
+                }
+            }
+            self.forcing.differentiate(&mut w);
+            factor *= horizon / (i + 1) as f64;
+            self.terms = i + 2;
+            if i > 4 && next.amax() * factor <= 1e-18 * size {
+                break;
+            }
+        }
+    }
+
+    /// The expanded solution at `τ` after the expansion point.
+    fn evaluate(&self, tau: f64, out: &mut DVector<f64>) {
+        out.copy_from(&self.derivs[0]);
+        let mut c = 1.0;
+        for (i, d) in self.derivs[1..self.terms].iter().enumerate() {
+            c *= tau / (i + 1) as f64;
+            out.axpy(c, d, 1.0);
+        }
+    }
+
+    /// The time `τ <= h` after the expansion point at which element `e`'s `u` reaches the
+    /// edge of its piece (Newton from `guess`); `x` becomes the state there.
+    fn locate(&self, x: &mut DVector<f64>, guess: f64, h: f64, e: usize, up: bool) -> f64 {
+        let (lo, hi) = self.pieces.interval(e);
+        let edge = if up { hi } else { lo };
+        let mut tau = guess;
+        for _ in 0..12 {
+            self.evaluate(tau, x);
+            let (u, du) = self.element_state(e, x);
+            let g = u - edge;
+            if g.abs() <= 1e-14 * (edge.abs() + self.scale_q) || du == 0.0 {
+                return tau;
+            }
+            tau = (tau - g / du).clamp(1e-3 * guess, h);
+        }
+        self.evaluate(tau, x);
+        tau
+    }
+
+    /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`, and
+    /// applies the saltation matrix of a force jump to `Φ̃`:
+    /// `δq̇ += -M⁻¹ w Δf (wᵀ δq) / u̇`, scaled `δṽ += -M⁻¹ w Δf (wᵀ δq̃) / (u̇ ω_s)`.
+    fn cross(&mut self, e: usize, up: bool, theta: f64, x: &DVector<f64>, phi: &mut DMatrix<f64>) {
+        let n = self.n;
+        let (u, du) = self.element_state(e, x);
+        let (before, _, _) = self.pieces.law(self.sys, e, theta, u, du);
+        self.pieces.cross(e, up);
+        let (after, _, _) = self.pieces.law(self.sys, e, theta, u, du);
+        let jump = after - before;
+        if jump.abs() <= 1e-9 * before.abs().max(after.abs()) || du == 0.0 {
+            return;
+        }
+        let factor = -jump / (du * self.scale_v / self.scale_q);
+        let mw = &self.mw[e];
+        for c in 0..2 * n {
+            let wq = self.sys.gather(e, &phi.column(c).as_slice()[..n]);
+            for i in 0..n {
+                phi[(n + i, c)] += factor * mw[i] * wq;
+            }
+        }
+    }
+}

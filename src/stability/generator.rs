@@ -1,0 +1,235 @@
+//! The pieces' generators of the exponential flow ([`exponential`](super::exponential)) and
+//! what is kept per generator: the scaled load as an oscillator ([`Forcing`]), and per
+//! distinct generator ([`State`]) the Taylor powers, the exact sub-step `(E_δ₀, X_δ₀)` and the
+//! ladder `E_δ₀^{2^j}`.
+//!
+//! **Forcing.** With the oscillator state `z = (1, cos k₁Ωt, sin k₁Ωt, …)` over the load
+//! orders, `z' = S z`, and `C` its map to the loads summed per loaded DOF, the scaled load is
+//! `b̃(t) = [0; G C z(t)]`, `G = M⁻¹ Vᵀ[e_l …] / s_v`; the piece adds the constant
+//! `[0; -Σ f0_e M⁻¹ w_e / s_v]` on the state `z₀ = 1`. Its `i`-th time derivative is
+//! `[0; G C Sⁱ z]`.
+//!
+//! **Sub-step.** Over `δ` from `(x̃, z)` the exact solution is `x̃ ← E_δ x̃ + X_δ z` with
+//! `E_δ = e^{Ãδ}` and `X_δ = ∫₀^δ e^{Ã(δ-s)} B e^{Ss} ds = Σ_{j>=0} δ^{j+1} φ_{j+1}(Ãδ) B Sʲ`
+//! (`B` the forcing matrix), cut at the first `p` with `(kΩδ)^{p+1}/(p+1)! < 1e-16`. Both are
+//! formed at `δ₀/2^f` with `‖Ã δ₀/2^f‖₁ <= 1` and doubled `f` times:
+//! `E_{2δ} = E_δ²`, `X_{2δ} = E_δ X_δ + X_δ e^{Sδ}` (two sub-steps in a row).
+//!
+//! **Ladder.** `L_j = E_δ₀^{2^j}`, squared on demand, so that `m` whole sub-steps of the
+//! monodromy matrix cost one product per set bit of `m`.
+
+use super::expm::{inverse_factorial, phi_narrow, squarings, ExpWork, Powers};
+use super::system::Coordinates;
+use nalgebra::{DMatrix, DVector};
+
+/// Highest power of `Sδ` in the forcing's series.
+const MAX_DEGREE: usize = 8;
+
+/// The load as an oscillator.
+pub(crate) struct Forcing {
+    omega: f64,
+    /// The load orders (0 first: the constant state).
+    orders: Vec<usize>,
+    /// `G` (n × loaded DOFs).
+    dirs: DMatrix<f64>,
+    /// `C Sʲ`, `j = 0..=MAX_DEGREE`.
+    channels: Vec<DMatrix<f64>>,
+    /// `S`.
+    generator: DMatrix<f64>,
+}
+
+impl Forcing {
+    pub(crate) fn new(sys: &Coordinates, m_inv: &DMatrix<f64>, scale_v: f64, omega: f64) -> Self {
+        let model = sys.model;
+        let n = sys.len();
+        let mut orders: Vec<usize> = model.loads().iter().map(|l| l.order).collect();
+        orders.push(0);
+        orders.sort_unstable();
+        orders.dedup();
+        let states = 2 * orders.len() - 1;
+        let mut dofs: Vec<usize> = model.loads().iter().map(|l| l.dof).collect();
+        dofs.sort_unstable();
+        dofs.dedup();
+        let mut dirs = DMatrix::zeros(n, dofs.len());
+        let mut c = DMatrix::zeros(dofs.len(), states);
+        for (l, dir) in model.loads().iter().zip(&sys.loads) {
+            let d = dofs.binary_search(&l.dof).unwrap_or(0);
+            let mut col = DVector::zeros(n);
+            for &(i, w) in dir {
+                col[i] += w;
+            }
+            dirs.set_column(d, &(m_inv * col / scale_v));
+            match orders.iter().position(|&o| o == l.order) {
+                Some(i) if i > 0 => {
+                    c[(d, 2 * i - 1)] += l.cos;
+                    c[(d, 2 * i)] += l.sin;
+                }
+                _ => c[(d, 0)] += l.cos,
+            }
+        }
+        let mut generator = DMatrix::zeros(states, states);
+        for (i, &k) in orders.iter().enumerate().skip(1) {
+            let w = k as f64 * omega;
+            generator[(2 * i - 1, 2 * i)] = -w;
+            generator[(2 * i, 2 * i - 1)] = w;
+        }
+        let mut channels = vec![c];
+        for j in 1..=MAX_DEGREE {
+            let next = &channels[j - 1] * &generator;
+            channels.push(next);
+        }
+        Self {
+            omega,
+            orders,
+            dirs,
+            channels,
+            generator,
+        }
+    }
+
+    /// Number of oscillator states.
+    pub(crate) fn states(&self) -> usize {
+        self.generator.nrows()
+    }
+
+    /// The fastest load frequency.
+    fn top(&self) -> f64 {
+        self.orders.last().copied().unwrap_or(0) as f64 * self.omega
+    }
+
+    /// `z(t)`.
+    pub(crate) fn oscillator(&self, t: f64, z: &mut DVector<f64>) {
+        let (s1, c1) = (self.omega * t).sin_cos();
+        z[0] = 1.0;
+        let (mut c, mut s, mut k) = (1.0, 0.0, 0);
+        for (i, &order) in self.orders.iter().enumerate().skip(1) {
+            while k < order {
+                (c, s) = (c * c1 - s * s1, s * c1 + c * s1);
+                k += 1;
+            }
+            z[2 * i - 1] = c;
+            z[2 * i] = s;
+        }
+    }
+
+    /// `x ← x e^{Sδ}`, block by block.
+    fn rotate(&self, x: &mut DMatrix<f64>, delta: f64) {
+        for (i, &k) in self.orders.iter().enumerate().skip(1) {
+            let (s, c) = (k as f64 * self.omega * delta).sin_cos();
+            for r in 0..x.nrows() {
+                let (a, b) = (x[(r, 2 * i - 1)], x[(r, 2 * i)]);
+                x[(r, 2 * i - 1)] = a * c + b * s;
+                x[(r, 2 * i)] = -a * s + b * c;
+            }
+        }
+    }
+
+    /// `out += G C w` (the load's velocity rows for the oscillator vector `w`).
+    pub(crate) fn add_load(&self, w: &DVector<f64>, out: &mut [f64]) {
+        let per_dof = &self.channels[0] * w;
+        for (d, &v) in per_dof.iter().enumerate() {
+            for (o, g) in out.iter_mut().zip(self.dirs.column(d).iter()) {
+                *o += v * g;
+            }
+        }
+    }
+
+    /// `w ← S w`.
+    pub(crate) fn differentiate(&self, w: &mut DVector<f64>) {
+        *w = &self.generator * &*w;
+    }
+}
+
+/// What is kept of one generator `Ã`.
+pub(crate) struct State {
+    pub(crate) powers: Powers,
+    /// `E_δ₀` and the ladder `L_j = E_δ₀^{2^j}` (`ladder[0] = E_δ₀`).
+    ladder: Vec<DMatrix<f64>>,
+    /// `X_δ₀`.
+    pub(crate) x0: DMatrix<f64>,
+    /// The constant part of the forcing (velocity rows).
+    pub(crate) offset: DVector<f64>,
+}
+
+impl State {
+    /// The state of `a` with the forcing `forcing` plus `offset`, sub-step `delta0`.
+    pub(crate) fn new(
+        a: DMatrix<f64>,
+        offset: DVector<f64>,
+        forcing: &Forcing,
+        delta0: f64,
+        work: &mut ExpWork,
+    ) -> Self {
+        let powers = Powers::new(a);
+        let m = powers.a.nrows();
+        let n = m / 2;
+        let loads = forcing.dirs.ncols();
+        // δ = δ₀/2^f: the Taylor polynomial and the forcing's series both converged.
+        let mut fine = squarings(powers.norm * delta0);
+        let degree = loop {
+            let x = forcing.top() * delta0 / f64::powi(2.0, fine as i32);
+            match (1..=MAX_DEGREE)
+                .find(|&p| x.powi(p as i32 + 1) * inverse_factorial(p + 1) < 1e-16)
+            {
+                Some(p) => break p,
+                None => fine += 1,
+            }
+        };
+        let mut delta = delta0 / f64::powi(2.0, fine as i32);
+        let mut e = DMatrix::zeros(m, m);
+        work.taylor(&powers, delta, &mut e);
+        // φ_{j+1}(Ãδ) [0; G | offset], then X_δ = Σ_j δ^{j+1} φ_{j+1} [0; G] C Sʲ + δ φ₁ offset e₀ᵀ.
+        let mut v = DMatrix::zeros(m, loads + 1);
+        v.view_mut((n, 0), (n, loads)).copy_from(&forcing.dirs);
+        v.set_column(loads, &offset);
+        let z = &powers.a * delta;
+        let mut psi = vec![DMatrix::zeros(m, loads + 1); degree + 1];
+        let mut tmp = DMatrix::zeros(m, loads + 1);
+        phi_narrow(&z, &v, &mut psi, &mut tmp);
+        let mut x = DMatrix::zeros(m, forcing.states());
+        let mut power = delta;
+        for (j, p) in psi.iter().enumerate() {
+            x.gemm(power, &p.columns(0, loads), &forcing.channels[j], 1.0);
+            power *= delta;
+        }
+        for i in 0..m {
+            x[(i, 0)] += delta * psi[0][(i, loads)];
+        }
+        for _ in 0..fine {
+            let mut doubled = &e * &x;
+            forcing.rotate(&mut x, delta);
+            doubled += &x;
+            x = doubled;
+            e = &e * &e;
+            delta *= 2.0;
+        }
+        Self {
+            powers,
+            ladder: vec![e],
+            x0: x,
+            offset,
+        }
+    }
+
+    /// `E_δ₀`.
+    pub(crate) fn e0(&self) -> &DMatrix<f64> {
+        &self.ladder[0]
+    }
+
+    /// `phi ← E_δ₀^k phi` (`tmp` a buffer of its shape).
+    pub(crate) fn advance(&mut self, k: usize, phi: &mut DMatrix<f64>, tmp: &mut DMatrix<f64>) {
+        let mut j = 0;
+        while k >> j != 0 {
+            if j == self.ladder.len() {
+                let last = &self.ladder[j - 1];
+                let next = last * last;
+                self.ladder.push(next);
+            }
+            if (k >> j) & 1 == 1 {
+                tmp.gemm(1.0, &self.ladder[j], phi, 0.0);
+                std::mem::swap(phi, tmp);
+            }
+            j += 1;
+        }
+    }
+}

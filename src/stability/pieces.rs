@@ -1,0 +1,183 @@
+//! Where each element is relative to its kinks, shared by both flows ([`flow`](super::flow),
+//! [`exponential`](super::exponential)): the law evaluated on the current side of each kink
+//! (continued linearly from the one-sided limit where a state strays across), the side from a
+//! state, and the first crossing of a kink inside a step from the cubic Hermite interpolant of
+//! `u` (values and rates at both ends).
+
+use super::dopri::hermite;
+use super::system::Coordinates;
+
+/// `side[e] = j` means `kinks[e][j-1] <= u < kinks[e][j]` (open at the ends).
+pub(crate) struct Pieces {
+    kinks: Vec<Vec<f64>>,
+    side: Vec<usize>,
+}
+
+impl Pieces {
+    /// The finite kinks of every element of the model, sorted, every element below its first.
+    pub(crate) fn new(sys: &Coordinates) -> Self {
+        let kinks = sys
+            .model
+            .elements()
+            .iter()
+            .map(|e| {
+                let mut k: Vec<f64> = e
+                    .law()
+                    .kinks()
+                    .into_iter()
+                    .filter(|v| v.is_finite())
+                    .collect();
+                k.sort_by(f64::total_cmp);
+                k.dedup();
+                k
+            })
+            .collect::<Vec<_>>();
+        let side = vec![0; kinks.len()];
+        Self { kinks, side }
+    }
+
+    /// `true` if element `e` has a kink.
+    pub(crate) fn has_kinks(&self, e: usize) -> bool {
+        !self.kinks[e].is_empty()
+    }
+
+    /// The open interval of `u` of element `e`'s current piece.
+    pub(crate) fn interval(&self, e: usize) -> (f64, f64) {
+        let k = &self.kinks[e];
+        let j = self.side[e];
+        let lo = if j == 0 { f64::NEG_INFINITY } else { k[j - 1] };
+        let hi = k.get(j).copied().unwrap_or(f64::INFINITY);
+        (lo, hi)
+    }
+
+    /// A fixed point inside element `e`'s current interval: its affine coefficients are read
+    /// there, so that two visits of the same piece give bit-equal coefficients.
+    pub(crate) fn inside(&self, e: usize) -> f64 {
+        let (lo, hi) = self.interval(e);
+        let away = |edge: f64, dir: f64| {
+            if edge * dir < 0.0 {
+                0.0
+            } else if edge == 0.0 {
+                dir
+            } else {
+                2.0 * edge
+            }
+        };
+        match (lo.is_finite(), hi.is_finite()) {
+            (true, true) => 0.5 * (lo + hi),
+            (false, true) => away(hi, -1.0),
+            (true, false) => away(lo, 1.0),
+            (false, false) => 0.0,
+        }
+    }
+
+    /// Moves element `e` across the upper (`up`) or lower edge of its piece.
+    pub(crate) fn cross(&mut self, e: usize, up: bool) {
+        if up {
+            self.side[e] += 1;
+        } else {
+            self.side[e] -= 1;
+        }
+    }
+
+    /// Force and derivatives `(f, ∂f/∂u, ∂f/∂u̇)` of element `e` on its current piece at
+    /// `(θ, u, u̇)`.
+    pub(crate) fn law(
+        &self,
+        sys: &Coordinates,
+        e: usize,
+        theta: f64,
+        u: f64,
+        du: f64,
+    ) -> (f64, f64, f64) {
+        let law = sys.model.elements()[e].law();
+        let (lo, hi) = self.interval(e);
+        if u > lo && u < hi {
+            let f = law.force(theta, u, du);
+            let (k, d) = law.derivatives(theta, u, du);
+            return (f, k, d);
+        }
+        // Continue the piece linearly from just inside its edge.
+        let edge = if u <= lo { lo } else { hi };
+        let inside = nudge(edge, if u <= lo { 1.0 } else { -1.0 });
+        let f = law.force(theta, inside, du);
+        let (k, d) = law.derivatives(theta, inside, du);
+        (f + k * (u - inside), k, d)
+    }
+
+    /// Sets each element's piece from the positions `q` and rates `v` at the start (on a
+    /// kink, the side it is moving to).
+    pub(crate) fn init(&mut self, sys: &Coordinates, q: &[f64], v: &[f64]) {
+        for ei in 0..sys.weights.len() {
+            let (u, du) = (sys.gather(ei, q), sys.gather(ei, v));
+            self.side[ei] = self.kinks[ei]
+                .iter()
+                .filter(|&&kv| kv < u || (kv == u && du > 0.0))
+                .count();
+        }
+    }
+
+    /// The first crossing of element `e` out of its piece inside a step of length `h` along
+    /// which `u` goes from `u0` (rate `du0`) to `u1` (rate `du1`): `(fraction of the step,
+    /// upwards?)`, from 8 probes of the cubic Hermite interpolant and bisection on it. A
+    /// crossing is counted once `u` is `1e-13 (s_q + |kink|)` beyond the edge.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn crossing(
+        &self,
+        e: usize,
+        u0: f64,
+        u1: f64,
+        du0: f64,
+        du1: f64,
+        h: f64,
+        scale_q: f64,
+    ) -> Option<(f64, bool)> {
+        let (lo, hi) = self.interval(e);
+        if lo == f64::NEG_INFINITY && hi == f64::INFINITY {
+            return None;
+        }
+        let tol = 1e-13 * (scale_q + lo.abs().min(hi.abs()).min(1e300));
+        let outside = |u: f64| -> Option<bool> {
+            if u >= hi + tol {
+                Some(true)
+            } else if u <= lo - tol {
+                Some(false)
+            } else {
+                None
+            }
+        };
+        const PROBES: usize = 8;
+        let mut prev_s = 0.0;
+        for p in 1..=PROBES {
+            let s = p as f64 / PROBES as f64;
+            let u = if p == PROBES {
+                u1
+            } else {
+                hermite(u0, u1, du0, du1, h, s)
+            };
+            if let Some(up) = outside(u) {
+                // Bisection on the interpolant inside [prev_s, s].
+                let edge = if up { hi } else { lo };
+                let (mut a, mut b) = (prev_s, s);
+                for _ in 0..50 {
+                    let mid = 0.5 * (a + b);
+                    let um = hermite(u0, u1, du0, du1, h, mid);
+                    if (um - edge) * (if up { 1.0 } else { -1.0 }) >= 0.0 {
+                        b = mid;
+                    } else {
+                        a = mid;
+                    }
+                }
+                return Some((b, up));
+            }
+            prev_s = s;
+        }
+        None
+    }
+}
+
+/// A point just inside a kink at `x`, on the side `direction` (±1).
+fn nudge(x: f64, direction: f64) -> f64 {
+    let step = 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE);
+    x + direction * step
+}
