@@ -19,7 +19,8 @@ fn dir(name: &str) -> PathBuf {
     d
 }
 
-/// A scene file `name` in the test directory with `text`.
+/// A scene file `name` in the test directory with `text` (names carry the test's tag: the
+/// tests run in parallel).
 fn scene(name: &str, text: &str) -> String {
     let p = dir("scenes").parent().unwrap().join(name);
     std::fs::write(&p, text).unwrap();
@@ -28,17 +29,17 @@ fn scene(name: &str, text: &str) -> String {
 
 /// The Duffing oscillator forced so hard (1e100) that the residual overflows: a numerical
 /// failure of valid input.
-fn overflowing() -> String {
+fn overflowing(tag: &str) -> String {
     let text = std::fs::read_to_string(example("duffing.toml"))
         .unwrap()
         .replace("cos = 0.1 }", "cos = 1e100 }");
-    scene("overflowing.toml", &text)
+    scene(&format!("overflowing_{tag}.toml"), &text)
 }
 
 /// A static-only scene (no dynamic load): its spectrum is empty.
-fn static_only() -> String {
+fn static_only(tag: &str) -> String {
     scene(
-        "static_only.toml",
+        &format!("static_only_{tag}.toml"),
         "dofs = [\"x\"]\nmass = [[1.0]]\nstiffness = [[4.0]]\ndamping = [[0.1]]\n\
          fundamental = { rad_s = 1.0 }\nharmonics = { count = 4 }\n\
          loads = [{ dof = \"x\", order = 0, cos = 2.0 }]\n",
@@ -58,8 +59,8 @@ fn expect(args: &[&str], code: i32, stderr_has: &str) -> std::process::Output {
 }
 
 /// An `--out` that cannot be created: a path under a regular file.
-fn unusable_out() -> String {
-    let file = dir("a_file");
+fn unusable_out(tag: &str) -> String {
+    let file = dir(&format!("a_file_{tag}"));
     std::fs::write(&file, "").unwrap();
     file.join("sub").to_str().unwrap().to_string()
 }
@@ -73,7 +74,7 @@ fn solve_exit_codes() {
     let out = expect(
         &[
             "solve",
-            &static_only(),
+            &static_only("solve_exit_codes"),
             "--json",
             "--out",
             out_dir.to_str().unwrap(),
@@ -88,13 +89,18 @@ fn solve_exit_codes() {
     assert!(!out_dir.join("spectrum.svg").exists());
     // A numerical failure at the start names the scene: 1, not 2.
     expect(
-        &["solve", &overflowing()],
+        &["solve", &overflowing("solve_exit_codes")],
         1,
-        "overflowing.toml: non-finite value",
+        "overflowing_solve_exit_codes.toml: non-finite value",
     );
     // An unusable --out before any work.
     expect(
-        &["solve", &duffing, "--out", &unusable_out()],
+        &[
+            "solve",
+            &duffing,
+            "--out",
+            &unusable_out("solve_exit_codes"),
+        ],
         2,
         "cannot create the directory",
     );
@@ -126,7 +132,14 @@ fn sweep_and_compare_exit_codes() {
         "--to must be a finite speed > 0",
     );
     expect(
-        &["sweep", &duffing, "--to", "1", "--out", &unusable_out()],
+        &[
+            "sweep",
+            &duffing,
+            "--to",
+            "1",
+            "--out",
+            &unusable_out("sweep_and_compare_exit_codes"),
+        ],
         2,
         "cannot create the directory",
     );
@@ -137,19 +150,32 @@ fn sweep_and_compare_exit_codes() {
     );
     // compare: refuses an unusable --out before the time-domain run.
     let out = expect(
-        &["compare", &duffing, "--out", &unusable_out()],
+        &[
+            "compare",
+            &duffing,
+            "--out",
+            &unusable_out("sweep_and_compare_exit_codes"),
+        ],
         2,
         "cannot create the directory",
     );
     assert!(out.stdout.is_empty(), "nothing computed");
-    expect(&["compare", &overflowing()], 1, "non-finite value");
+    expect(
+        &["compare", &overflowing("sweep_and_compare_exit_codes")],
+        1,
+        "non-finite value",
+    );
 }
 
 #[test]
 fn modes_check_and_report_exit_codes() {
     let duffing = example("duffing.toml");
     expect(&["check", &duffing], 0, "");
-    expect(&["check", &static_only()], 0, "");
+    expect(
+        &["check", &static_only("modes_check_and_report_exit_codes")],
+        0,
+        "",
+    );
     expect(
         &[
             "check",
@@ -164,11 +190,20 @@ fn modes_check_and_report_exit_codes() {
         2,
         "need 0 <= from < to",
     );
-    expect(&["modes", &overflowing()], 1, "non-finite value");
+    expect(
+        &["modes", &overflowing("modes_check_and_report_exit_codes")],
+        1,
+        "non-finite value",
+    );
     // report: a numerical failure of the solve is on the page, and the exit code is 1.
     let out_dir = dir("report_failing");
     expect(
-        &["report", &overflowing(), "--out", out_dir.to_str().unwrap()],
+        &[
+            "report",
+            &overflowing("modes_check_and_report_exit_codes"),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
         1,
         "non-finite value",
     );
@@ -178,7 +213,12 @@ fn modes_check_and_report_exit_codes() {
         "the failure is on the page"
     );
     expect(
-        &["report", &duffing, "--out", &unusable_out()],
+        &[
+            "report",
+            &duffing,
+            "--out",
+            &unusable_out("modes_check_and_report_exit_codes"),
+        ],
         2,
         "cannot create the directory",
     );
