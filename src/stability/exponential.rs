@@ -217,6 +217,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         let (mut e_tau, mut tmp) = (DMatrix::zeros(s2, s2), DMatrix::zeros(s2, s2));
         let mut z = DVector::zeros(self.forcing.states());
         let mut x_new = DVector::zeros(s2);
+        let elements = self.mw.len();
+        let (mut at_start, mut at_end) = (vec![(0.0, 0.0); elements], vec![(0.0, 0.0); elements]);
         self.pieces.init(self.sys, &y[..n], &y[n..s2]);
         let (omega, delta0) = (self.omega, self.delta0);
         let bounds = self.bounds.clone();
@@ -241,15 +243,18 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 // Whole sub-steps until a crossing.
                 let mut done = 0;
                 let mut hit = None;
+                self.kink_states(&x, &mut at_start);
                 for k in 0..whole as usize {
                     self.forcing.oscillator(t + k as f64 * delta0, &mut z);
                     x_new.gemv(1.0, state.e0(), &x, 0.0);
                     x_new.gemv(1.0, &state.x0, &z, 1.0);
-                    hit = self.first_crossing(&x, &x_new, delta0);
+                    self.kink_states(&x_new, &mut at_end);
+                    hit = self.first_crossing(&at_start, &at_end, delta0);
                     if hit.is_some() {
                         break;
                     }
                     std::mem::swap(&mut x, &mut x_new);
+                    std::mem::swap(&mut at_start, &mut at_end);
                     done += 1;
                 }
                 let t_sub = t + done as f64 * delta0;
@@ -264,7 +269,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                     let r = (tb - t_sub).max(0.0);
                     self.expand(piece.state, &x, t_sub, r);
                     self.evaluate(r, &mut x_new);
-                    match self.first_crossing(&x, &x_new, r) {
+                    self.kink_states(&x_new, &mut at_end);
+                    match self.first_crossing(&at_start, &at_end, r) {
                         Some((s, e, up)) => (self.locate(&mut x, s * r, r, e, up), Some((e, up))),
                         None => {
                             std::mem::swap(&mut x, &mut x_new);
@@ -303,21 +309,28 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         Ok(true)
     }
 
-    /// The earliest kink crossing between the scaled states `x0` and `x1` a time `h` apart:
-    /// `(fraction, element, upwards?)`.
+    /// `(u, u̇)` of every element with kinks at the scaled state `x̃` (the others untouched).
+    fn kink_states(&self, x: &DVector<f64>, out: &mut [(f64, f64)]) {
+        for (e, o) in out.iter_mut().enumerate() {
+            if self.pieces.has_kinks(e) {
+                *o = self.element_state(e, x);
+            }
+        }
+    }
+
+    /// The earliest kink crossing over a time `h` with the elements' `(u, u̇)` going from
+    /// `start` to `end`: `(fraction, element, upwards?)`.
     fn first_crossing(
         &self,
-        x0: &DVector<f64>,
-        x1: &DVector<f64>,
+        start: &[(f64, f64)],
+        end: &[(f64, f64)],
         h: f64,
     ) -> Option<(f64, usize, bool)> {
         let mut best: Option<(f64, usize, bool)> = None;
-        for e in 0..self.mw.len() {
+        for (e, (&(u0, du0), &(u1, du1))) in start.iter().zip(end).enumerate() {
             if !self.pieces.has_kinks(e) {
                 continue;
             }
-            let (u0, du0) = self.element_state(e, x0);
-            let (u1, du1) = self.element_state(e, x1);
             if let Some((s, up)) = self.pieces.crossing(e, u0, u1, du0, du1, h, self.scale_q) {
                 if best.is_none_or(|(b, _, _)| s < b) {
                     best = Some((s, e, up));
@@ -332,8 +345,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
     fn expand(&mut self, state: usize, x: &DVector<f64>, t: f64, horizon: f64) {
         let n = self.n;
         let s = &self.states[state];
-        let mut w = DVector::zeros(self.forcing.states());
-        self.forcing.oscillator(t, &mut w);
+        let mut z = DVector::zeros(self.forcing.states());
+        self.forcing.oscillator(t, &mut z);
         if self.derivs.is_empty() {
             self.derivs.push(DVector::zeros(2 * n));
         }
@@ -349,13 +362,12 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             let next = &mut next[0];
             next.gemv(1.0, &s.powers.a, &done[i], 0.0);
             let v = &mut next.as_mut_slice()[n..];
-            self.forcing.add_load(&w, v);
+            self.forcing.add_load_derivative(&z, i, v);
             if i == 0 {
                 for (o, c) in v.iter_mut().zip(&s.offset.as_slice()[n..]) {
                     *o += c;
                 }
             }
-            self.forcing.differentiate(&mut w);
             factor *= horizon / (i + 1) as f64;
             self.terms = i + 2;
             if i > 4 && next.amax() * factor <= 1e-18 * size {

@@ -124,19 +124,30 @@ impl Forcing {
         }
     }
 
-    /// `out += G C w` (the load's velocity rows for the oscillator vector `w`).
-    pub(crate) fn add_load(&self, w: &DVector<f64>, out: &mut [f64]) {
-        let per_dof = &self.channels[0] * w;
-        for (d, &v) in per_dof.iter().enumerate() {
-            for (o, g) in out.iter_mut().zip(self.dirs.column(d).iter()) {
-                *o += v * g;
+    /// `out += G C Sⁱ z` (the velocity rows of the load's `i`-th time derivative at the
+    /// oscillator state `z`): per order `k` the pair `(c, s)` turned by `iπ/2` and scaled by
+    /// `(kΩ)ⁱ`.
+    pub(crate) fn add_load_derivative(&self, z: &DVector<f64>, i: usize, out: &mut [f64]) {
+        let c = &self.channels[0];
+        for d in 0..c.nrows() {
+            let mut v = if i == 0 { c[(d, 0)] * z[0] } else { 0.0 };
+            for (b, &k) in self.orders.iter().enumerate().skip(1) {
+                let (x, y) = (z[2 * b - 1], z[2 * b]);
+                let (x, y) = match i % 4 {
+                    0 => (x, y),
+                    1 => (-y, x),
+                    2 => (-x, -y),
+                    _ => (y, -x),
+                };
+                let scale = (k as f64 * self.omega).powi(i as i32);
+                v += scale * (c[(d, 2 * b - 1)] * x + c[(d, 2 * b)] * y);
+            }
+            if v != 0.0 {
+                for (o, g) in out.iter_mut().zip(self.dirs.column(d).iter()) {
+                    *o += v * g;
+                }
             }
         }
-    }
-
-    /// `w ← S w`.
-    pub(crate) fn differentiate(&self, w: &mut DVector<f64>) {
-        *w = &self.generator * &*w;
     }
 }
 

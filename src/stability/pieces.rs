@@ -137,6 +137,12 @@ impl Pieces {
             return None;
         }
         let tol = 1e-13 * (scale_q + lo.abs().min(hi.abs()).min(1e300));
+        // The interpolant stays within the end values widened by (4/27) h |u̇| at each end
+        // (the largest Hermite basis functions for the rates): no probe needed inside that.
+        let reach = 0.15 * h.abs() * (du0.abs() + du1.abs());
+        if u0.min(u1) - reach > lo - tol && u0.max(u1) + reach < hi + tol {
+            return None;
+        }
         let outside = |u: f64| -> Option<bool> {
             if u >= hi + tol {
                 Some(true)
