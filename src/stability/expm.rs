@@ -231,7 +231,7 @@ mod tests {
         let m = 6;
         let a = sample(m, 1.5, 11);
         let b = sample(m, 1.0, 12).columns(0, 3).into_owned();
-        let delta = 0.37;
+        let delta = 0.15;
         let z = &a * delta;
         assert!(norm1(&z) <= 1.0);
         let mut out = vec![DMatrix::zeros(m, 3); 3];
