@@ -97,9 +97,19 @@ fn main() -> Result<()> {
             estimate,
             ..reduced
         };
-        let (rk1, f_rk) = timed(repeat, with(Integrator::RungeKutta, false), &model, &solution)?;
+        let (rk1, f_rk) = timed(
+            repeat,
+            with(Integrator::RungeKutta, false),
+            &model,
+            &solution,
+        )?;
         let (exp1, f_exp) = timed(repeat, with(Integrator::Auto, false), &model, &solution)?;
-        let (rk2, _) = timed(repeat, with(Integrator::RungeKutta, true), &model, &solution)?;
+        let (rk2, _) = timed(
+            repeat,
+            with(Integrator::RungeKutta, true),
+            &model,
+            &solution,
+        )?;
         let (exp2, f_est) = timed(repeat, with(Integrator::Auto, true), &model, &solution)?;
         let info = f_est.reduction.clone().expect("a reduced analysis");
         let (dense_rk, dense_exp, to_dense) = if n <= dense_up_to {

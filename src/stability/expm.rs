@@ -43,6 +43,18 @@ pub(crate) struct Powers {
 }
 
 impl Powers {
+    pub(crate) fn a2(&self) -> &DMatrix<f64> {
+        &self.a2
+    }
+
+    pub(crate) fn a3(&self) -> &DMatrix<f64> {
+        &self.a3
+    }
+
+    pub(crate) fn a4(&self) -> &DMatrix<f64> {
+        &self.a4
+    }
+
     pub(crate) fn new(a: DMatrix<f64>) -> Self {
         let a2 = &a * &a;
         let a3 = &a2 * &a;

@@ -23,8 +23,8 @@
 //! * a kink crossing is detected on every sub-step from the cubic Hermite interpolant of `u` as
 //!   in the Runge–Kutta flow and located by Newton on the same Taylor series;
 //! * the monodromy matrix: one product per set bit of `m`, and `e^{Ãτ}` for the last part
-//!   (`τ = r`, or up to the crossing) by the Taylor polynomial from the kept powers; at a
-//!   crossing the saltation matrix of a force jump.
+//!   (`τ = r`, or up to the crossing) by the Taylor polynomial, a linear combination of the kept
+//!   `Ãⁱ/i!`; at a crossing the saltation matrix of a force jump.
 //!
 //! The laws' coefficients are read at a fixed point inside each kink interval
 //! ([`Pieces::inside`]), so that equal pieces give bit-equal keys. At the end of every piece
@@ -291,7 +291,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 let state = &mut self.states[piece.state];
                 state.advance(done, &mut phi, &mut tmp);
                 if tau > 0.0 {
-                    self.work.exp(&state.powers, tau, &mut e_tau);
+                    state.exp_short(tau, &mut e_tau, &mut self.work);
                     tmp.gemm(1.0, &e_tau, &phi, 0.0);
                     std::mem::swap(&mut phi, &mut tmp);
                 }

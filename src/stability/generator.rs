@@ -176,6 +176,8 @@ pub(crate) struct State {
     pub(crate) x0: DMatrix<f64>,
     /// The constant part of the forcing (velocity rows).
     pub(crate) offset: DVector<f64>,
+    /// `Aⁱ/i!`, `i = 0..=16`, formed at the first short exponential.
+    terms: Vec<DMatrix<f64>>,
 }
 
 impl State {
@@ -235,6 +237,43 @@ impl State {
             ladder: vec![e],
             x0: x,
             offset,
+            terms: Vec::new(),
+        }
+    }
+
+    /// `out = e^{Aτ}`. For `‖Aτ‖₁ <= 1` (the pieces' last parts are shorter than `δ₀`) the
+    /// Taylor polynomial `Σ_{i<=d} τⁱ (Aⁱ/i!)` from the kept terms, `d` the first degree whose
+    /// next term is below 1e-16 of the norm (at most 16): a linear combination, no product;
+    /// scaling and squaring otherwise.
+    pub(crate) fn exp_short(&mut self, tau: f64, out: &mut DMatrix<f64>, work: &mut ExpWork) {
+        let x = self.powers.norm * tau.abs();
+        if x > 1.0 {
+            work.exp(&self.powers, tau, out);
+            return;
+        }
+        if self.terms.is_empty() {
+            let p = &self.powers;
+            let m = p.a.nrows();
+            self.terms = vec![
+                DMatrix::identity(m, m),
+                p.a.clone(),
+                p.a2() / 2.0,
+                p.a3() / 6.0,
+                p.a4() / 24.0,
+            ];
+            for i in 5..=16 {
+                let next = &self.terms[i - 1] * &p.a / i as f64;
+                self.terms.push(next);
+            }
+        }
+        let degree = (1..16)
+            .find(|&d| x.powi(d as i32 + 1) * inverse_factorial(d + 1) < 1e-16)
+            .unwrap_or(16);
+        out.copy_from(&self.terms[degree]);
+        for term in self.terms[..degree].iter().rev() {
+            for (o, t) in out.as_mut_slice().iter_mut().zip(term.as_slice()) {
+                *o = *o * tau + t;
+            }
         }
     }
 
