@@ -1,17 +1,21 @@
 //! Stability at scale: the Floquet multipliers of the drivetrain benchmark
 //! (`hbal::catalog::Drivetrain`, 2000 rpm, m = 4 meshes, H = 32) against the number of DOFs,
-//! with the dense monodromy matrix (`2n × 2n`) where it is affordable and on the reduced basis
-//! (modes below 3 H Ω plus attachment modes). A Markdown table on stdout.
+//! on the reduced basis (modes below 3 H Ω plus attachment modes) with the exponential flow
+//! (the default for these piecewise-affine laws) and with the Dormand–Prince flow, and the
+//! dense monodromy matrix (`2n × 2n`) where it is affordable. A Markdown table on stdout.
 //!
-//! `cargo run --release --example stability_scale [-- --max-dofs N] [-- --dense-up-to N]`
-//! (defaults 10000 and 100). "reduced" is one analysis on the basis without the accuracy
-//! estimate; "with estimate" adds the second analysis on the basis with twice the cut-off.
-//! The last line estimates a 500-point run-up sweep with stability at n = 1000 from the
-//! measured costs (one warm-started Newton point and one reduced analysis per point).
+//! `cargo run --release --example stability_scale [-- --max-dofs N] [--dense-up-to N]
+//! [--repeat R]` (defaults 10000, 20, 3). Times are medians over `R` runs of this thread's CPU
+//! time (`/proc/thread-self/schedstat` on Linux, else wall clock): the machine may be shared.
+//! "one analysis" is without the reduction's estimate, "with estimate" adds the comparison on
+//! the basis with twice the cut-off (what `hbal solve` runs). The last line estimates a
+//! 500-point run-up sweep with stability at n = 1000 from one point (two shooting periods, no
+//! estimate, modes reused: see `examples/stability_sweep.rs` for the measured sweep).
 
 use hbal::catalog::Drivetrain;
-use hbal::stability::{FloquetMethod, FloquetOptions};
+use hbal::stability::{Floquet, FloquetMethod, FloquetOptions, Integrator};
 use hbal::{Formulation, HarmonicBalance, HarmonicBasis, Newton, Solution};
+use hbal::{Model, Result};
 use std::time::Instant;
 
 /// Engine speed (rpm).
@@ -26,12 +30,55 @@ fn argument(name: &str, default: usize) -> usize {
         .unwrap_or(default)
 }
 
-fn main() -> hbal::Result<()> {
+/// CPU time of this thread in ms (wall clock where `/proc` is not there).
+fn cpu_ms(start: Instant) -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or_else(|| start.elapsed().as_secs_f64() * 1e3, |ns| ns * 1e-6)
+}
+
+/// The median time of `repeat` analyses and the last result.
+fn timed(
+    repeat: usize,
+    options: FloquetOptions,
+    model: &Model,
+    solution: &Solution,
+) -> Result<(f64, Floquet)> {
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..repeat {
+        let origin = Instant::now();
+        let start = cpu_ms(origin);
+        last = Some(options.compute(model, solution)?);
+        times.push(cpu_ms(origin) - start);
+    }
+    times.sort_by(f64::total_cmp);
+    Ok((times[times.len() / 2], last.expect("one run")))
+}
+
+/// `max_i min_j |a_i - b_j|` over the leading four of `a`.
+fn distance(a: &Floquet, b: &Floquet) -> f64 {
+    a.multipliers
+        .iter()
+        .take(4)
+        .map(|m| {
+            b.multipliers
+                .iter()
+                .map(|o| (m - o).norm())
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}
+
+fn main() -> Result<()> {
     let max_dofs = argument("--max-dofs", 10_000);
-    let dense_up_to = argument("--dense-up-to", 100);
+    let dense_up_to = argument("--dense-up-to", 20);
+    let repeat = argument("--repeat", 3).max(1);
     println!("## Floquet multipliers of the drivetrain (m = 4, H = 32, {RPM} rpm)\n");
-    println!("| n | HB point ms | basis r + a | dense ms | reduced ms | with estimate ms | max abs(μ) dense | max abs(μ) reduced | estimate | distance to dense | neutral | steps |");
-    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("CPU ms, median of {repeat}; RK = Dormand–Prince 5(4), rtol 1e-8; exp = exponential flow.\n");
+    println!("| n | HB point | basis r + a | one analysis RK | exp | ratio | with estimate RK | exp | ratio | dense RK | dense exp | max abs(μ) | exp vs RK | exp vs dense | estimate | steps RK / exp |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     let mut sweep = None;
     for n in [20, 100, 1000, 10_000]
         .into_iter()
@@ -44,68 +91,70 @@ fn main() -> hbal::Result<()> {
         let t = Instant::now();
         let solution: Solution = Newton::new().solve(&hb, &mut hb.workspace())?;
         let t_hb = t.elapsed().as_secs_f64() * 1e3;
-        let dense = (n <= dense_up_to).then(|| {
-            let t = Instant::now();
-            let f = FloquetOptions::new()
-                .with_method(FloquetMethod::Dense)
-                .compute(&model, &solution);
-            (t.elapsed().as_secs_f64() * 1e3, f)
-        });
-        let reduced_options = FloquetOptions {
-            estimate: false,
-            ..FloquetOptions::new().with_method(FloquetMethod::Reduced)
+        let reduced = FloquetOptions::new().with_method(FloquetMethod::Reduced);
+        let with = |integrator, estimate| FloquetOptions {
+            integrator,
+            estimate,
+            ..reduced
         };
-        let t = Instant::now();
-        let reduced = reduced_options.compute(&model, &solution)?;
-        let t_reduced = t.elapsed().as_secs_f64() * 1e3;
-        let t = Instant::now();
-        let estimated = FloquetOptions::new()
-            .with_method(FloquetMethod::Reduced)
-            .compute(&model, &solution)?;
-        let t_estimated = t.elapsed().as_secs_f64() * 1e3;
-        let info = estimated.reduction.clone().expect("a reduced analysis");
-        let (t_dense, mu_dense, distance) = match &dense {
-            Some((t, Ok(f))) => (
-                format!("{t:.1}"),
-                format!("{:.6}", f.max_abs()),
-                format!(
-                    "{:.1e}",
-                    reduced
-                        .multipliers
-                        .iter()
-                        .take(4)
-                        .map(|m| f
-                            .multipliers
-                            .iter()
-                            .map(|o| (m - o).norm())
-                            .fold(f64::INFINITY, f64::min))
-                        .fold(0.0, f64::max)
-                ),
-            ),
-            Some((_, Err(e))) => (format!("{e}"), "-".into(), "-".into()),
-            None => ("-".into(), "-".into(), "-".into()),
+        let (rk1, f_rk) = timed(
+            repeat,
+            with(Integrator::RungeKutta, false),
+            &model,
+            &solution,
+        )?;
+        let (exp1, f_exp) = timed(repeat, with(Integrator::Auto, false), &model, &solution)?;
+        let (rk2, _) = timed(
+            repeat,
+            with(Integrator::RungeKutta, true),
+            &model,
+            &solution,
+        )?;
+        let (exp2, f_est) = timed(repeat, with(Integrator::Auto, true), &model, &solution)?;
+        let info = f_est.reduction.clone().expect("a reduced analysis");
+        let (dense_rk, dense_exp, to_dense) = if n <= dense_up_to {
+            let dense = FloquetOptions::new().with_method(FloquetMethod::Dense);
+            let (a, _) = timed(
+                1,
+                FloquetOptions {
+                    integrator: Integrator::RungeKutta,
+                    ..dense
+                },
+                &model,
+                &solution,
+            )?;
+            let (b, f) = timed(repeat, dense, &model, &solution)?;
+            (
+                format!("{a:.0}"),
+                format!("{b:.0}"),
+                format!("{:.1e}", distance(&f_exp, &f)),
+            )
+        } else {
+            ("-".into(), "-".into(), "-".into())
         };
         println!(
-            "| {n} | {t_hb:.1} | {} + {} | {t_dense} | {t_reduced:.1} | {t_estimated:.1} | {mu_dense} | {:.6} | {:.1e} (against {}) | {distance} | {} / {} | {} |",
+            "| {n} | {t_hb:.1} | {} + {} | {rk1:.0} | {exp1:.0} | {:.1} | {rk2:.0} | {exp2:.0} | {:.1} | {dense_rk} | {dense_exp} | {:.9} | {:.1e} | {to_dense} | {:.1e} (against {}) | {} / {} |",
             info.modes,
             info.attachment,
-            reduced.max_abs(),
+            rk1 / exp1,
+            rk2 / exp2,
+            f_exp.max_abs(),
+            distance(&f_exp, &f_rk),
             info.estimate.unwrap_or(f64::NAN),
             info.comparison_dofs.unwrap_or(0),
-            reduced.neutral,
-            estimated.neutral,
-            reduced.steps,
+            f_rk.steps,
+            f_exp.steps,
         );
         if n == 1000 {
-            sweep = Some((t_hb, t_reduced));
+            sweep = Some((t_hb, exp1));
         }
     }
-    if let Some((t_hb, t_reduced)) = sweep {
+    if let Some((t_hb, t_floquet)) = sweep {
         println!(
-            "\n500-point run-up sweep with stability at n = 1000 (estimated from one point): {:.1} s (HB {:.1} s, stability {:.1} s)",
-            500.0 * (t_hb + t_reduced) / 1e3,
+            "\n500-point run-up sweep with stability at n = 1000 (estimated from one point: HB from the linear start, one analysis): {:.1} s (HB {:.1} s, stability {:.1} s)",
+            500.0 * (t_hb + t_floquet) / 1e3,
             500.0 * t_hb / 1e3,
-            500.0 * t_reduced / 1e3
+            500.0 * t_floquet / 1e3
         );
     }
     Ok(())

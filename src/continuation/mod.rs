@@ -202,6 +202,9 @@ pub struct Branch {
     pub start: String,
     /// Why it ended.
     pub stop: BranchStop,
+    /// What the Floquet analyses of consecutive points share (modes, orbit correction).
+    #[serde(skip)]
+    pub(crate) stability_cache: crate::stability::FloquetCache,
 }
 
 fn one() -> usize {
@@ -245,6 +248,7 @@ impl Branch {
             points: Vec::new(),
             start,
             stop: BranchStop::Reached,
+            stability_cache: Default::default(),
         }
     }
 
@@ -278,7 +282,10 @@ pub struct Continuation {
     /// Corrector iterations before the step is halved. Default 8.
     pub max_corrector: usize,
     /// How to compute the stability of every point (`None`: no stability). Default: the
-    /// default [`FloquetOptions`].
+    /// default [`FloquetOptions`]. Consecutive points share a
+    /// [`FloquetCache`](crate::stability::FloquetCache); the reduction's estimate
+    /// ([`FloquetOptions::estimate`]) is computed at the first point and wherever the
+    /// stability changes.
     pub stability: Option<FloquetOptions>,
     /// Estimate the error of every point against the solution with 2H harmonics (a Newton
     /// solve there from the point: about the cost of the point's own corrector times 8 with

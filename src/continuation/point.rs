@@ -18,7 +18,7 @@
 use super::{Branch, BranchPoint, Continuation};
 use crate::model::Model;
 use crate::solution::Solution;
-use crate::stability::Bifurcation;
+use crate::stability::{Bifurcation, FloquetOptions};
 use crate::HarmonicBasis;
 use num_complex::Complex64;
 
@@ -49,32 +49,48 @@ impl Continuation {
             Ok(s) => s,
             Err(e) => return Some(e.to_string()),
         };
+        let prev = branch.points.last().and_then(|q| q.floquet.clone());
+        let prev_stable = prev.as_ref().map(|f| f.is_stable());
         let (floquet, failure) = match &self.stability {
             // Laws with memory: stability unknown (see FloquetOptions::compute), the branch goes on.
             Some(_) if model.memory_element().is_some() => (None, None),
-            Some(options) => match options.compute(model, &sol) {
-                // A non-finite multiplier would reach the outputs as NaN or `null`: it ends
-                // the branch here, named, instead.
-                Ok(f)
-                    if !f
-                        .multipliers
-                        .iter()
-                        .all(|m| m.re.is_finite() && m.im.is_finite()) =>
-                {
-                    (
-                        None,
-                        Some(format!(
-                            "stability at Ω = {omega}: non-finite Floquet multiplier"
-                        )),
-                    )
+            Some(options) => {
+                // The modes and the last orbit correction carry over from point to point; the
+                // reduction's estimate is computed where a label is decided: at the first
+                // point and wherever the stability changes.
+                let cache = &mut branch.stability_cache;
+                let quick = FloquetOptions {
+                    estimate: false,
+                    ..*options
+                };
+                let f = quick.compute_with(model, &sol, cache).and_then(|mut f| {
+                    if options.estimate && prev_stable != Some(f.is_stable()) {
+                        options.add_estimate(model, &sol, &mut f, cache)?;
+                    }
+                    Ok(f)
+                });
+                match f {
+                    // A non-finite multiplier would reach the outputs as NaN or `null`: it
+                    // ends the branch here, named, instead.
+                    Ok(f)
+                        if !f
+                            .multipliers
+                            .iter()
+                            .all(|m| m.re.is_finite() && m.im.is_finite()) =>
+                    {
+                        (
+                            None,
+                            Some(format!(
+                                "stability at Ω = {omega}: non-finite Floquet multiplier"
+                            )),
+                        )
+                    }
+                    Ok(f) => (Some(f), None),
+                    Err(e) => (None, Some(format!("stability at Ω = {omega}: {e}"))),
                 }
-                Ok(f) => (Some(f), None),
-                Err(e) => (None, Some(format!("stability at Ω = {omega}: {e}"))),
-            },
+            }
             None => (None, None),
         };
-        let prev = branch.points.last().and_then(|q| q.floquet.clone());
-        let prev_stable = prev.as_ref().map(|f| f.is_stable());
         let stable = floquet.as_ref().map(|f| f.is_stable());
         // The kind comes from the unstable side, where the critical multiplier is outside.
         let bifurcation = match (prev_stable, stable) {

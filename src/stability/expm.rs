@@ -2,7 +2,8 @@
 //! ([`exponential`](super::exponential)).
 //!
 //! **Exponential.** For `‖Z‖₁ <= 1` the Taylor polynomial of degree 16,
-//! `T(Z) = Σ_{i<=16} Zⁱ/i!`, differs from `e^Z` by at most `Σ_{i>16} 1/i! < 3e-15`; it is
+//! `T(Z) = Σ_{i<=16} Zⁱ/i!`, differs from `e^Z` by at most `Σ_{i>16} 1/i! < 3e-15` (degree 12
+//! for `‖Z‖₁ <= 0.33` and 8 for `<= 0.07` keep the first omitted term below 1e-16); it is
 //! evaluated by Paterson–Stockmeyer: `Z², Z³, Z⁴`, then
 //! `T = B₀ + Z⁴(B₁ + Z⁴(B₂ + Z⁴(B₃ + Z⁴/16!)))` with `B_k = Σ_{i<4} Z^i/(4k+i)!`. For
 //! `Z = δA` the powers are `δⁱAⁱ`: with `A², A³, A⁴` kept per generator ([`Powers`]) an
@@ -42,6 +43,18 @@ pub(crate) struct Powers {
 }
 
 impl Powers {
+    pub(crate) fn a2(&self) -> &DMatrix<f64> {
+        &self.a2
+    }
+
+    pub(crate) fn a3(&self) -> &DMatrix<f64> {
+        &self.a3
+    }
+
+    pub(crate) fn a4(&self) -> &DMatrix<f64> {
+        &self.a4
+    }
+
     pub(crate) fn new(a: DMatrix<f64>) -> Self {
         let a2 = &a * &a;
         let a3 = &a2 * &a;
@@ -71,8 +84,8 @@ impl ExpWork {
         }
     }
 
-    /// `out = T(δA)`, the degree-16 Taylor polynomial of `e^{δA}` (accurate for
-    /// `‖δA‖₁ <= 1`), in three products from the cached powers.
+    /// `out = T(δA)`, the Taylor polynomial of `e^{δA}` (accurate for `‖δA‖₁ <= 1`) of degree
+    /// 8, 12 or 16 by the norm, in one to three products from the cached powers.
     pub(crate) fn taylor(&mut self, p: &Powers, delta: f64, out: &mut DMatrix<f64>) {
         let c = inverse_factorials();
         let m = p.a.nrows();
@@ -90,11 +103,21 @@ impl ExpWork {
                 dst[(j, j)] += c[4 * k];
             }
         };
-        // acc = B₃ + Z⁴/16!, then acc = B_k + Z⁴ acc for k = 2, 1, 0.
+        // Degree 4m: 8 for ‖Z‖₁ <= 0.07, 12 for <= 0.33, else 16 (the first omitted term
+        // below 1e-16 for the first two, 3e-15 at ‖Z‖₁ = 1).
+        let norm = p.norm * delta.abs();
+        let m4 = if norm <= 0.07 {
+            2
+        } else if norm <= 0.33 {
+            3
+        } else {
+            4
+        };
+        // acc = B_{m-1} + Z⁴/(4m)!, then acc = B_k + Z⁴ acc for k = m-2, …, 0.
         let mut acc = std::mem::replace(&mut self.acc, DMatrix::zeros(0, 0));
-        block(3, &mut acc, false);
-        add_scaled(&mut acc, c[16] * d4, &p.a4);
-        for k in (0..3).rev() {
+        block(m4 - 1, &mut acc, false);
+        add_scaled(&mut acc, c[4 * m4] * d4, &p.a4);
+        for k in (0..m4 - 1).rev() {
             self.tmp.gemm(d4, &p.a4, &acc, 0.0);
             std::mem::swap(&mut acc, &mut self.tmp);
             block(k, &mut acc, true);
@@ -199,6 +222,14 @@ mod tests {
         ExpWork::new(12).exp(&powers, 1.0, &mut out);
         let err = (&out - &reference).amax() / reference.amax();
         assert!(err < 1e-12, "{err:e}");
+        // Short steps take the degree-8 and degree-12 polynomials.
+        for t in [1e-3, 6e-3, 2e-2] {
+            let mut short = DMatrix::zeros(12, 12);
+            ExpWork::new(12).exp(&powers, t, &mut short);
+            let exact = (&powers.a * t).exp();
+            let err = (&short - &exact).amax() / exact.amax();
+            assert!(err < 4e-15, "t = {t}: {err:e}");
+        }
         // A product of half steps is the full step.
         let mut half = DMatrix::zeros(12, 12);
         ExpWork::new(12).exp(&powers, 0.5, &mut half);

@@ -14,8 +14,8 @@
 //! multiplied by `e^{Ãh}`, whatever the stiffness (the contact modes at 10⁵ rad/s that cap an
 //! explicit step cost nothing here). A period of the drivetrain has about 700 pieces but only
 //! about 40 distinct generators `Ã`; each is kept with its exact sub-step over the flow's
-//! `δ₀ = 2^{-⌈log₂ ω_max⌉}` (`ω_max δ₀ <= 1`, ω_max the fastest frequency along the orbit) and
-//! the ladder `E_δ₀^{2^j}` ([`generator`](super::generator)). A piece `h = m δ₀ + r` costs:
+//! `δ₀ = 2^{-⌈log₂ ω_f⌉}` (`ω_f δ₀ <= 1`, ω_f the fastest frequency along the orbit or of the
+//! load) and the ladder `E_δ₀^{2^j}` ([`generator`](super::generator)). A piece `h = m δ₀ + r` costs:
 //!
 //! * the orbit: `m` sub-steps `x̃ ← E_δ₀ x̃ + X_δ₀ z(t)` (`z` the load oscillator), then the
 //!   remainder `r` by the Taylor series of the exact solution,
@@ -23,8 +23,8 @@
 //! * a kink crossing is detected on every sub-step from the cubic Hermite interpolant of `u` as
 //!   in the Runge–Kutta flow and located by Newton on the same Taylor series;
 //! * the monodromy matrix: one product per set bit of `m`, and `e^{Ãτ}` for the last part
-//!   (`τ = r`, or up to the crossing) by the Taylor polynomial from the kept powers; at a
-//!   crossing the saltation matrix of a force jump.
+//!   (`τ = r`, or up to the crossing) by the Taylor polynomial, a linear combination of the kept
+//!   `Ãⁱ/i!`; at a crossing the saltation matrix of a force jump.
 //!
 //! The laws' coefficients are read at a fixed point inside each kink interval
 //! ([`Pieces::inside`]), so that equal pieces give bit-equal keys. At the end of every piece
@@ -33,7 +33,7 @@
 //! Runge–Kutta flow.
 
 use super::expm::ExpWork;
-use super::generator::{Forcing, State};
+use super::generator::{Expansion, Forcing, State};
 use super::pieces::Pieces;
 use super::system::Coordinates;
 use crate::error::{Error, Result};
@@ -57,13 +57,14 @@ pub(crate) struct ExpFlow<'c, 'm> {
     /// `M⁻¹ w_e` (unscaled).
     mw: Vec<DVector<f64>>,
     forcing: Forcing,
+    /// The oscillator's turn over δ₀.
+    turns: Vec<(f64, f64)>,
     work: ExpWork,
     /// The generators met so far, and their index by the laws' coefficients.
     states: Vec<State>,
     index: HashMap<Vec<u64>, usize>,
-    /// Taylor coefficients `x̃⁽ⁱ⁾` of the exact solution from the last expansion point.
-    derivs: Vec<DVector<f64>>,
-    terms: usize,
+    /// The Taylor series of the exact solution from the last expansion point.
+    taylor: Expansion,
     /// Integration steps (sub-steps and remainders) over all periods.
     pub(crate) steps: usize,
 }
@@ -112,6 +113,10 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 })
             })
             .collect();
+        let forcing = Forcing::new(sys, &m_inv, scale_v, omega);
+        let fastest = omega_max.max(omega).max(forcing.top());
+        let delta0 = f64::powi(2.0, -(fastest.log2().ceil() as i32));
+        let turns = forcing.turns(delta0);
         Ok(Self {
             sys,
             n,
@@ -120,16 +125,16 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             pieces: Pieces::new(sys),
             scale_q,
             scale_v,
-            delta0: f64::powi(2.0, -(omega_max.max(omega).log2().ceil() as i32)),
+            delta0,
             max_steps,
             base,
             mw,
-            forcing: Forcing::new(sys, &m_inv, scale_v, omega),
+            forcing,
+            turns,
             work: ExpWork::new(2 * n),
             states: Vec::new(),
             index: HashMap::new(),
-            derivs: Vec::new(),
-            terms: 0,
+            taylor: Expansion::default(),
             steps: 0,
         })
     }
@@ -217,6 +222,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         let (mut e_tau, mut tmp) = (DMatrix::zeros(s2, s2), DMatrix::zeros(s2, s2));
         let mut z = DVector::zeros(self.forcing.states());
         let mut x_new = DVector::zeros(s2);
+        let elements = self.mw.len();
+        let (mut at_start, mut at_end) = (vec![(0.0, 0.0); elements], vec![(0.0, 0.0); elements]);
         self.pieces.init(self.sys, &y[..n], &y[n..s2]);
         let (omega, delta0) = (self.omega, self.delta0);
         let bounds = self.bounds.clone();
@@ -241,30 +248,37 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 // Whole sub-steps until a crossing.
                 let mut done = 0;
                 let mut hit = None;
-                for k in 0..whole as usize {
-                    self.forcing.oscillator(t + k as f64 * delta0, &mut z);
+                self.kink_states(&x, &mut at_start);
+                self.forcing.oscillator(t, &mut z);
+                for _ in 0..whole as usize {
                     x_new.gemv(1.0, state.e0(), &x, 0.0);
                     x_new.gemv(1.0, &state.x0, &z, 1.0);
-                    hit = self.first_crossing(&x, &x_new, delta0);
+                    self.kink_states(&x_new, &mut at_end);
+                    hit = self.first_crossing(&at_start, &at_end, delta0);
                     if hit.is_some() {
                         break;
                     }
                     std::mem::swap(&mut x, &mut x_new);
+                    std::mem::swap(&mut at_start, &mut at_end);
+                    self.forcing.advance(&self.turns, &mut z);
                     done += 1;
                 }
                 let t_sub = t + done as f64 * delta0;
                 // The last part: up to the crossing, or the remainder.
                 let (tau, crossed) = if let Some((s, e, up)) = hit {
-                    self.expand(piece.state, &x, t_sub, delta0);
+                    let state = &self.states[piece.state];
+                    self.taylor.expand(state, &self.forcing, &x, t_sub, delta0);
                     (
                         self.locate(&mut x, s * delta0, delta0, e, up),
                         Some((e, up)),
                     )
                 } else {
                     let r = (tb - t_sub).max(0.0);
-                    self.expand(piece.state, &x, t_sub, r);
-                    self.evaluate(r, &mut x_new);
-                    match self.first_crossing(&x, &x_new, r) {
+                    let state = &self.states[piece.state];
+                    self.taylor.expand(state, &self.forcing, &x, t_sub, r);
+                    self.taylor.evaluate(r, &mut x_new);
+                    self.kink_states(&x_new, &mut at_end);
+                    match self.first_crossing(&at_start, &at_end, r) {
                         Some((s, e, up)) => (self.locate(&mut x, s * r, r, e, up), Some((e, up))),
                         None => {
                             std::mem::swap(&mut x, &mut x_new);
@@ -277,7 +291,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 let state = &mut self.states[piece.state];
                 state.advance(done, &mut phi, &mut tmp);
                 if tau > 0.0 {
-                    self.work.exp(&state.powers, tau, &mut e_tau);
+                    state.exp_short(tau, &mut e_tau, &mut self.work);
                     tmp.gemm(1.0, &e_tau, &phi, 0.0);
                     std::mem::swap(&mut phi, &mut tmp);
                 }
@@ -303,21 +317,28 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         Ok(true)
     }
 
-    /// The earliest kink crossing between the scaled states `x0` and `x1` a time `h` apart:
-    /// `(fraction, element, upwards?)`.
+    /// `(u, u̇)` of every element with kinks at the scaled state `x̃` (the others untouched).
+    fn kink_states(&self, x: &DVector<f64>, out: &mut [(f64, f64)]) {
+        for (e, o) in out.iter_mut().enumerate() {
+            if self.pieces.has_kinks(e) {
+                *o = self.element_state(e, x);
+            }
+        }
+    }
+
+    /// The earliest kink crossing over a time `h` with the elements' `(u, u̇)` going from
+    /// `start` to `end`: `(fraction, element, upwards?)`.
     fn first_crossing(
         &self,
-        x0: &DVector<f64>,
-        x1: &DVector<f64>,
+        start: &[(f64, f64)],
+        end: &[(f64, f64)],
         h: f64,
     ) -> Option<(f64, usize, bool)> {
         let mut best: Option<(f64, usize, bool)> = None;
-        for e in 0..self.mw.len() {
+        for (e, (&(u0, du0), &(u1, du1))) in start.iter().zip(end).enumerate() {
             if !self.pieces.has_kinks(e) {
                 continue;
             }
-            let (u0, du0) = self.element_state(e, x0);
-            let (u1, du1) = self.element_state(e, x1);
             if let Some((s, up)) = self.pieces.crossing(e, u0, u1, du0, du1, h, self.scale_q) {
                 if best.is_none_or(|(b, _, _)| s < b) {
                     best = Some((s, e, up));
@@ -327,53 +348,6 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         best
     }
 
-    /// The Taylor coefficients `x̃⁽ⁱ⁾` at `t` of the exact solution through `x̃` on the piece
-    /// `state`, until their terms over `horizon` are below 1e-18 of the state.
-    fn expand(&mut self, state: usize, x: &DVector<f64>, t: f64, horizon: f64) {
-        let n = self.n;
-        let s = &self.states[state];
-        let mut w = DVector::zeros(self.forcing.states());
-        self.forcing.oscillator(t, &mut w);
-        if self.derivs.is_empty() {
-            self.derivs.push(DVector::zeros(2 * n));
-        }
-        self.derivs[0].copy_from(x);
-        let size = x.amax().max(f64::MIN_POSITIVE);
-        let mut factor = 1.0;
-        self.terms = 1;
-        for i in 0..100 {
-            if self.derivs.len() == i + 1 {
-                self.derivs.push(DVector::zeros(2 * n));
-            }
-            let (done, next) = self.derivs.split_at_mut(i + 1);
-            let next = &mut next[0];
-            next.gemv(1.0, &s.powers.a, &done[i], 0.0);
-            let v = &mut next.as_mut_slice()[n..];
-            self.forcing.add_load(&w, v);
-            if i == 0 {
-                for (o, c) in v.iter_mut().zip(&s.offset.as_slice()[n..]) {
-                    *o += c;
-                }
-            }
-            self.forcing.differentiate(&mut w);
-            factor *= horizon / (i + 1) as f64;
-            self.terms = i + 2;
-            if i > 4 && next.amax() * factor <= 1e-18 * size {
-                break;
-            }
-        }
-    }
-
-    /// The expanded solution at `τ` after the expansion point.
-    fn evaluate(&self, tau: f64, out: &mut DVector<f64>) {
-        out.copy_from(&self.derivs[0]);
-        let mut c = 1.0;
-        for (i, d) in self.derivs[1..self.terms].iter().enumerate() {
-            c *= tau / (i + 1) as f64;
-            out.axpy(c, d, 1.0);
-        }
-    }
-
     /// The time `τ <= h` after the expansion point at which element `e`'s `u` reaches the
     /// edge of its piece (Newton from `guess`); `x` becomes the state there.
     fn locate(&self, x: &mut DVector<f64>, guess: f64, h: f64, e: usize, up: bool) -> f64 {
@@ -381,7 +355,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         let edge = if up { hi } else { lo };
         let mut tau = guess;
         for _ in 0..12 {
-            self.evaluate(tau, x);
+            self.taylor.evaluate(tau, x);
             let (u, du) = self.element_state(e, x);
             let g = u - edge;
             if g.abs() <= 1e-14 * (edge.abs() + self.scale_q) || du == 0.0 {
@@ -389,30 +363,24 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             }
             tau = (tau - g / du).clamp(1e-3 * guess, h);
         }
-        self.evaluate(tau, x);
+        self.taylor.evaluate(tau, x);
         tau
     }
 
-    /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`, and
-    /// applies the saltation matrix of a force jump to `Φ̃`:
-    /// `δq̇ += -M⁻¹ w Δf (wᵀ δq) / u̇`, scaled `δṽ += -M⁻¹ w Δf (wᵀ δq̃) / (u̇ ω_s)`.
+    /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`
+    /// ([`Pieces::cross_with_saltation`]).
     fn cross(&mut self, e: usize, up: bool, theta: f64, x: &DVector<f64>, phi: &mut DMatrix<f64>) {
-        let n = self.n;
         let (u, du) = self.element_state(e, x);
-        let (before, _, _) = self.pieces.law(self.sys, e, theta, u, du);
-        self.pieces.cross(e, up);
-        let (after, _, _) = self.pieces.law(self.sys, e, theta, u, du);
-        let jump = after - before;
-        if jump.abs() <= 1e-9 * before.abs().max(after.abs()) || du == 0.0 {
-            return;
-        }
-        let factor = -jump / (du * self.scale_v / self.scale_q);
-        let mw = &self.mw[e];
-        for c in 0..2 * n {
-            let wq = self.sys.gather(e, &phi.column(c).as_slice()[..n]);
-            for i in 0..n {
-                phi[(n + i, c)] += factor * mw[i] * wq;
-            }
-        }
+        let omega_s = self.scale_v / self.scale_q;
+        let mw = self.mw[e].as_slice();
+        self.pieces.cross_with_saltation(
+            self.sys,
+            e,
+            up,
+            (theta, u, du),
+            mw,
+            omega_s,
+            phi.as_mut_slice(),
+        );
     }
 }

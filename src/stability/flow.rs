@@ -196,42 +196,10 @@ impl<'c, 'm> Flow<'c, 'm> {
         out.gemm(-1.0, &bc, &phi_m, 0.0);
     }
 
-    /// `(cos Ωt, sin Ωt)` from the phasor at the step start by a short Taylor series of
-    /// `e^{iΩ(t - t_b)}` (a stage is at most one step from it); `sin_cos` further away.
+    /// `(cos Ωt, sin Ωt)` from the phasor at the step start ([`super::dopri::turn`]).
     fn phasor(&self, t: f64) -> (f64, f64) {
         let (tb, cb, sb) = self.phasor_base;
-        let x = self.omega * (t - tb);
-        let (cx, sx) = if x.abs() <= 0.25 {
-            // Terms up to x¹³/13! (< 3e-16 for |x| <= 1/4), Horner form.
-            let x2 = x * x;
-            let c = 1.0
-                - x2 * (1.0 / 2.0)
-                    * (1.0
-                        - x2 * (1.0 / 12.0)
-                            * (1.0
-                                - x2 * (1.0 / 30.0)
-                                    * (1.0
-                                        - x2 * (1.0 / 56.0)
-                                            * (1.0
-                                                - x2 * (1.0 / 90.0)
-                                                    * (1.0 - x2 * (1.0 / 132.0))))));
-            let s = x
-                * (1.0
-                    - x2 * (1.0 / 6.0)
-                        * (1.0
-                            - x2 * (1.0 / 20.0)
-                                * (1.0
-                                    - x2 * (1.0 / 42.0)
-                                        * (1.0
-                                            - x2 * (1.0 / 72.0)
-                                                * (1.0
-                                                    - x2 * (1.0 / 110.0)
-                                                        * (1.0 - x2 * (1.0 / 156.0)))))));
-            (c, s)
-        } else {
-            let (s, c) = x.sin_cos();
-            (c, s)
-        };
+        let (cx, sx) = super::dopri::turn(self.omega * (t - tb));
         (cb * cx - sb * sx, sb * cx + cb * sx)
     }
 
@@ -404,37 +372,16 @@ impl<'c, 'm> Flow<'c, 'm> {
     }
 
     /// Moves element `e` across its kink at time `t` and applies the saltation matrix of a
-    /// force jump to `Φ̃`.
+    /// force jump to `Φ̃` ([`Pieces::cross_with_saltation`]).
     fn cross(&mut self, e: usize, up: bool, t: f64, y: &mut [f64]) {
         let n = self.n;
         let (ta, tha, lo, hi) = self.segment;
         let theta = (tha + self.omega * (t - ta)).clamp(lo, hi);
         let sys = self.sys;
         let (u, du) = (sys.gather(e, &y[..n]), sys.gather(e, &y[n..2 * n]));
-        let (f_before, _, _) = self.element_law(e, theta, u, du);
-        self.pieces.cross(e, up);
-        let (f_after, _, _) = self.element_law(e, theta, u, du);
-        let jump = f_after - f_before;
-        let size = f_before.abs().max(f_after.abs());
-        if jump.abs() <= 1e-9 * size || du == 0.0 {
-            return;
-        }
-        // δq̇ += -M⁻¹ w Δf (wᵀ δq) / u̇, in the scaled coordinates.
-        let mut mw = vec![0.0; n];
-        for i in 0..n {
-            mw[i] = sys.weights[e]
-                .iter()
-                .map(|&(j, wj)| self.m_inv[(i, j)] * wj)
-                .sum();
-        }
-        let factor = -jump / (du * self.omega_s);
-        let s2 = 2 * n;
-        for c in 0..s2 {
-            let col = &mut y[s2 + c * s2..s2 + (c + 1) * s2];
-            let wq = sys.gather(e, &col[..n]);
-            for i in 0..n {
-                col[n + i] += factor * mw[i] * wq;
-            }
-        }
+        let mw = &self.mw[e];
+        let (_, phi) = y.split_at_mut(2 * n);
+        self.pieces
+            .cross_with_saltation(sys, e, up, (theta, u, du), mw, self.omega_s, phi);
     }
 }

@@ -93,7 +93,7 @@ impl Forcing {
     }
 
     /// The fastest load frequency.
-    fn top(&self) -> f64 {
+    pub(crate) fn top(&self) -> f64 {
         self.orders.last().copied().unwrap_or(0) as f64 * self.omega
     }
 
@@ -124,19 +124,46 @@ impl Forcing {
         }
     }
 
-    /// `out += G C w` (the load's velocity rows for the oscillator vector `w`).
+    /// `z ← e^{Sδ} z` (each pair turned by `kΩδ`; `turns` from [`Forcing::turns`]).
+    pub(crate) fn advance(&self, turns: &[(f64, f64)], z: &mut DVector<f64>) {
+        for (b, &(s, c)) in turns.iter().enumerate().skip(1) {
+            let (x, y) = (z[2 * b - 1], z[2 * b]);
+            z[2 * b - 1] = c * x - s * y;
+            z[2 * b] = s * x + c * y;
+        }
+    }
+
+    /// `(sin kΩδ, cos kΩδ)` per order (the constant state first).
+    pub(crate) fn turns(&self, delta: f64) -> Vec<(f64, f64)> {
+        self.orders
+            .iter()
+            .map(|&k| (k as f64 * self.omega * delta).sin_cos())
+            .collect()
+    }
+
+    /// `out += G C w` for the oscillator vector `w` (the load's velocity rows; `w = Sⁱ z` gives
+    /// its `i`-th time derivative).
     pub(crate) fn add_load(&self, w: &DVector<f64>, out: &mut [f64]) {
-        let per_dof = &self.channels[0] * w;
-        for (d, &v) in per_dof.iter().enumerate() {
-            for (o, g) in out.iter_mut().zip(self.dirs.column(d).iter()) {
-                *o += v * g;
+        let c = &self.channels[0];
+        for d in 0..c.nrows() {
+            let v = c.row(d).dot(&w.transpose());
+            if v != 0.0 {
+                for (o, g) in out.iter_mut().zip(self.dirs.column(d).iter()) {
+                    *o += v * g;
+                }
             }
         }
     }
 
-    /// `w ← S w`.
+    /// `w ← S w` (each pair `(c, s)` of order `k` becomes `kΩ (-s, c)`, the constant 0).
     pub(crate) fn differentiate(&self, w: &mut DVector<f64>) {
-        *w = &self.generator * &*w;
+        w[0] = 0.0;
+        for (b, &k) in self.orders.iter().enumerate().skip(1) {
+            let f = k as f64 * self.omega;
+            let (x, y) = (w[2 * b - 1], w[2 * b]);
+            w[2 * b - 1] = -f * y;
+            w[2 * b] = f * x;
+        }
     }
 }
 
@@ -149,6 +176,8 @@ pub(crate) struct State {
     pub(crate) x0: DMatrix<f64>,
     /// The constant part of the forcing (velocity rows).
     pub(crate) offset: DVector<f64>,
+    /// `Aⁱ/i!`, `i = 0..=16`, formed at the first short exponential.
+    terms: Vec<DMatrix<f64>>,
 }
 
 impl State {
@@ -208,6 +237,43 @@ impl State {
             ladder: vec![e],
             x0: x,
             offset,
+            terms: Vec::new(),
+        }
+    }
+
+    /// `out = e^{Aτ}`. For `‖Aτ‖₁ <= 1` (the pieces' last parts are shorter than `δ₀`) the
+    /// Taylor polynomial `Σ_{i<=d} τⁱ (Aⁱ/i!)` from the kept terms, `d` the first degree whose
+    /// next term is below 1e-16 of the norm (at most 16): a linear combination, no product;
+    /// scaling and squaring otherwise.
+    pub(crate) fn exp_short(&mut self, tau: f64, out: &mut DMatrix<f64>, work: &mut ExpWork) {
+        let x = self.powers.norm * tau.abs();
+        if x > 1.0 {
+            work.exp(&self.powers, tau, out);
+            return;
+        }
+        if self.terms.is_empty() {
+            let p = &self.powers;
+            let m = p.a.nrows();
+            self.terms = vec![
+                DMatrix::identity(m, m),
+                p.a.clone(),
+                p.a2() / 2.0,
+                p.a3() / 6.0,
+                p.a4() / 24.0,
+            ];
+            for i in 5..=16 {
+                let next = &self.terms[i - 1] * &p.a / i as f64;
+                self.terms.push(next);
+            }
+        }
+        let degree = (1..16)
+            .find(|&d| x.powi(d as i32 + 1) * inverse_factorial(d + 1) < 1e-16)
+            .unwrap_or(16);
+        out.copy_from(&self.terms[degree]);
+        for term in self.terms[..degree].iter().rev() {
+            for (o, t) in out.as_mut_slice().iter_mut().zip(term.as_slice()) {
+                *o = *o * tau + t;
+            }
         }
     }
 
@@ -230,6 +296,71 @@ impl State {
                 std::mem::swap(phi, tmp);
             }
             j += 1;
+        }
+    }
+}
+
+/// The Taylor series of the exact solution of a piece through a state:
+/// `x̃(t+τ) = Σ τⁱ x̃⁽ⁱ⁾/i!`, `x̃⁽ⁱ⁺¹⁾ = Ã x̃⁽ⁱ⁾ + b̃⁽ⁱ⁾(t)` (`b̃⁽ⁱ⁾` the load's derivatives
+/// and, for `i = 0`, the piece's constant).
+#[derive(Default)]
+pub(crate) struct Expansion {
+    derivs: Vec<DVector<f64>>,
+    terms: usize,
+}
+
+impl Expansion {
+    /// The coefficients at `t` through `x̃` on the piece `state`, until their terms over
+    /// `horizon` are below 1e-18 of the state.
+    pub(crate) fn expand(
+        &mut self,
+        state: &State,
+        forcing: &Forcing,
+        x: &DVector<f64>,
+        t: f64,
+        horizon: f64,
+    ) {
+        let m = x.len();
+        let n = m / 2;
+        let mut z = DVector::zeros(forcing.states());
+        forcing.oscillator(t, &mut z);
+        if self.derivs.is_empty() {
+            self.derivs.push(DVector::zeros(m));
+        }
+        self.derivs[0].copy_from(x);
+        let size = x.amax().max(f64::MIN_POSITIVE);
+        let mut factor = 1.0;
+        self.terms = 1;
+        for i in 0..100 {
+            if self.derivs.len() == i + 1 {
+                self.derivs.push(DVector::zeros(m));
+            }
+            let (done, next) = self.derivs.split_at_mut(i + 1);
+            let next = &mut next[0];
+            next.gemv(1.0, &state.powers.a, &done[i], 0.0);
+            let v = &mut next.as_mut_slice()[n..];
+            forcing.add_load(&z, v);
+            forcing.differentiate(&mut z);
+            if i == 0 {
+                for (o, c) in v.iter_mut().zip(&state.offset.as_slice()[n..]) {
+                    *o += c;
+                }
+            }
+            factor *= horizon / (i + 1) as f64;
+            self.terms = i + 2;
+            if i > 4 && next.amax() * factor <= 1e-18 * size {
+                break;
+            }
+        }
+    }
+
+    /// The expanded solution at `τ` after the expansion point.
+    pub(crate) fn evaluate(&self, tau: f64, out: &mut DVector<f64>) {
+        out.copy_from(&self.derivs[0]);
+        let mut c = 1.0;
+        for (i, d) in self.derivs[1..self.terms].iter().enumerate() {
+            c *= tau / (i + 1) as f64;
+            out.axpy(c, d, 1.0);
         }
     }
 }

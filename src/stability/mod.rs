@@ -7,14 +7,24 @@
 //! `k(t) = ∂f/∂u`, `d(t) = ∂f/∂u̇` at `(Ω t, w·q*, w·q̇*)`.
 //!
 //! The monodromy matrix `Φ(T)` solves `Φ̇ = A(t) Φ`, `Φ(0) = I`, over one period; its
-//! eigenvalues are the Floquet multipliers. hbal integrates it together with the orbit itself
-//! ([`flow`](self) module: Dormand–Prince 5(4) with error control, the step limited by the
-//! fastest time scale of the model along the orbit, restarted at every time jump of a law and at
-//! every kink crossing, with the saltation matrix where a force jumps). It starts on the
-//! harmonic-balance orbit and polishes it by Newton shooting, `x₀ ← x₀ - (Φ - I)⁻¹ (φ_T(x₀) -
-//! x₀)`, so the multipliers belong to the exact periodic orbit next to the HB solution, to the
-//! integrator's tolerance, whatever H; the size of that correction
-//! ([`Floquet::orbit_correction`]) measures the HB solution's own error at `t = 0`.
+//! eigenvalues are the Floquet multipliers. hbal integrates it together with the orbit itself,
+//! restarted at every time jump of a law and at every kink crossing, with the saltation matrix
+//! where a force jumps ([`Integrator`]):
+//!
+//! * where every law is affine between its time jumps and kinks (rectangular or constant mesh
+//!   stiffness, backlash and stop contacts, linear springs and dampers), `A` is constant on
+//!   each piece and the flow is exact: `Φ` is multiplied by `e^{A h}` per piece, the orbit
+//!   marched by exact sub-steps with the load as an oscillator (`exponential` module), the
+//!   stiffness of contact modes costs nothing;
+//! * otherwise by Dormand–Prince 5(4) with error control, the step limited by the fastest time
+//!   scale of the model along the orbit (`flow` module).
+//!
+//! It starts on the harmonic-balance orbit and polishes it by Newton shooting,
+//! `x₀ ← x₀ - (Φ - I)⁻¹ (φ_T(x₀) - x₀)`, so the multipliers belong to the exact periodic orbit
+//! next to the HB solution, to the integrator's tolerance, whatever H; the size of that
+//! correction ([`Floquet::orbit_correction`]) measures the HB solution's own error at `t = 0`.
+//! A sweep's points share a [`FloquetCache`] (the modes of a reduced basis, the last orbit
+//! correction as the next shooting's start).
 //!
 //! Rigid-body modes give multipliers that are exactly 1 by construction; they are identified
 //! from the model ([`Floquet::neutral`]) and left out of [`Floquet::multipliers`] and the
@@ -116,7 +126,8 @@ pub struct Floquet {
     /// periodic orbit when [`Floquet::polished`]).
     #[serde(default)]
     pub orbit_start: Vec<f64>,
-    /// Integration steps (accepted, rejected and event re-steps) over all periods integrated.
+    /// Integration steps over all periods integrated: accepted, rejected and event re-steps of
+    /// the Runge–Kutta flow, or sub-steps and piece ends of the exponential flow.
     #[serde(default)]
     pub steps: usize,
     /// The reduced basis the multipliers were computed on, with its accuracy estimate; `None`
@@ -164,7 +175,9 @@ impl Floquet {
 /// Options of the Floquet analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FloquetOptions {
-    /// Relative tolerance of the integrator. Default 1e-8 (multipliers to about 1e-7 or better).
+    /// Relative tolerance of the Runge–Kutta integrator, and of the shooting (converged at a
+    /// scaled residual of `10 rtol`). Default 1e-8 (multipliers to about 1e-7 or better; the
+    /// exponential flow itself is exact up to rounding and the located crossings).
     pub rtol: f64,
     /// Newton shooting iterations (0: the multipliers along the orbit started from the HB
     /// state). Default 6.

@@ -136,16 +136,19 @@ fn m_orthonormalise(
     random: &mut impl FnMut(usize, usize) -> DMatrix<f64>,
 ) {
     let n = y.nrows();
+    let mut mx = nalgebra::DVector::zeros(n);
     for j in 0..y.ncols() {
         for attempt in 0..3 {
             let mut x = y.column(j).into_owned();
             let norm0 = m_norm(m, x.as_slice());
             for _ in 0..2 {
-                let mut mx = vec![0.0; n];
-                m.mul_add(1.0, x.as_slice(), &mut mx);
-                for i in 0..j {
-                    let c: f64 = y.column(i).iter().zip(&mx).map(|(a, b)| a * b).sum();
-                    x.axpy(-c, &y.column(i), 1.0);
+                // x -= Y_{<j} (Y_{<j}ᵀ M x), the previous columns at once.
+                mx.fill(0.0);
+                m.mul_add(1.0, x.as_slice(), mx.as_mut_slice());
+                if j > 0 {
+                    let previous = y.columns(0, j);
+                    let c = previous.tr_mul(&mx);
+                    x.gemv(-1.0, &previous, &c, 1.0);
                 }
             }
             let norm = m_norm(m, x.as_slice());

@@ -2,7 +2,7 @@
 //! [`exponential`](super::exponential)): the law evaluated on the current side of each kink
 //! (continued linearly from the one-sided limit where a state strays across), the side from a
 //! state, and the first crossing of a kink inside a step from the cubic Hermite interpolant of
-//! `u` (values and rates at both ends).
+//! `u` (values and rates at both ends); the saltation matrix of a force jump at a crossing.
 
 use super::dopri::hermite;
 use super::system::Coordinates;
@@ -80,6 +80,39 @@ impl Pieces {
         }
     }
 
+    /// Moves element `e` across its kink at `(θ, u, u̇)` and applies the saltation matrix of a
+    /// force jump `Δf` there to the scaled monodromy matrix `phi` (column-major, `2n × 2n`, `mw`
+    /// = `M⁻¹ w_e`, `omega_s = s_v/s_q`): with `g = w·q - kink` and `F = (q̇, M⁻¹(…))`,
+    /// `S = I + (F⁺ - F⁻) ∇gᵀ / (∇g·F⁻)` adds `-M⁻¹ w Δf (wᵀ δq) / u̇` to `δq̇`, scaled
+    /// `δṽ += -M⁻¹ w Δf (wᵀ δq̃) / (u̇ ω_s)`. Nothing where the force is continuous.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn cross_with_saltation(
+        &mut self,
+        sys: &Coordinates,
+        e: usize,
+        up: bool,
+        (theta, u, du): (f64, f64, f64),
+        mw: &[f64],
+        omega_s: f64,
+        phi: &mut [f64],
+    ) {
+        let (before, _, _) = self.law(sys, e, theta, u, du);
+        self.cross(e, up);
+        let (after, _, _) = self.law(sys, e, theta, u, du);
+        let jump = after - before;
+        if jump.abs() <= 1e-9 * before.abs().max(after.abs()) || du == 0.0 {
+            return;
+        }
+        let factor = -jump / (du * omega_s);
+        let n = mw.len();
+        for col in phi.chunks_exact_mut(2 * n) {
+            let wq = sys.gather(e, &col[..n]);
+            for (c, m) in col[n..].iter_mut().zip(mw) {
+                *c += factor * m * wq;
+            }
+        }
+    }
+
     /// Force and derivatives `(f, ∂f/∂u, ∂f/∂u̇)` of element `e` on its current piece at
     /// `(θ, u, u̇)`.
     pub(crate) fn law(
@@ -137,6 +170,12 @@ impl Pieces {
             return None;
         }
         let tol = 1e-13 * (scale_q + lo.abs().min(hi.abs()).min(1e300));
+        // The interpolant stays within the end values widened by (4/27) h |u̇| at each end
+        // (the largest Hermite basis functions for the rates): no probe needed inside that.
+        let reach = 0.15 * h.abs() * (du0.abs() + du1.abs());
+        if u0.min(u1) - reach > lo - tol && u0.max(u1) + reach < hi + tol {
+            return None;
+        }
         let outside = |u: f64| -> Option<bool> {
             if u >= hi + tol {
                 Some(true)

@@ -1,0 +1,156 @@
+//! Cost of the Floquet stability in a run-up sweep of a large model: the same continuation
+//! with and without stability, the stability's share per point, and how many shooting periods
+//! a point needed. A Markdown table on stdout.
+//!
+//! `cargo run --release --example stability_sweep [-- SCENE] [--from RPM] [--to RPM]
+//! [--max-step S] [--repeat R]`
+//!
+//! Defaults: `examples/scenes/large/drivetrain_1000.toml` from 1000 to 3000 in the scene's
+//! speed unit, the continuation's default largest step (1.0; 0.0075 gives about 500 points),
+//! one run of each. Times are wall clock and this thread's CPU time (`/proc/thread-self`, on
+//! Linux; the machine may be shared), the medians over the repeats. No error estimate per
+//! point (the HB side of `hbal sweep --no-error-estimate`).
+
+use hbal::continuation::{Branch, Continuation};
+use hbal::scene::Scene;
+use hbal::stability::FloquetOptions;
+use std::path::Path;
+use std::time::Instant;
+
+fn flag(args: &[String], name: &str, default: f64) -> f64 {
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// CPU time of this thread in ms (wall clock where `/proc` is not there).
+fn cpu_ms(start: Instant) -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or_else(|| start.elapsed().as_secs_f64() * 1e3, |ns| ns * 1e-6)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let path = args
+        .iter()
+        .find(|a| a.ends_with(".toml"))
+        .cloned()
+        .unwrap_or_else(|| "examples/scenes/large/drivetrain_1000.toml".into());
+    let scene = Scene::load(Path::new(&path))?;
+    let unit = scene.omega_per_speed;
+    let from = flag(&args, "--from", 1000.0) * unit;
+    let to = flag(&args, "--to", 3000.0) * unit;
+    let repeat = flag(&args, "--repeat", 1.0).max(1.0) as usize;
+    let basis = scene.basis.with_omega(from)?;
+    let run = |stability: Option<FloquetOptions>| -> Result<(f64, f64, Branch), hbal::Error> {
+        let (mut walls, mut cpus, mut last) = (Vec::new(), Vec::new(), None);
+        for _ in 0..repeat {
+            let c = Continuation {
+                max_step: flag(&args, "--max-step", 1.0),
+                method: scene.method,
+                stability,
+                ..Continuation::default()
+            };
+            let start = Instant::now();
+            let cpu = cpu_ms(start);
+            let branch = c.run(&scene.model, basis, to, |_| {})?;
+            cpus.push(cpu_ms(start) - cpu);
+            walls.push(start.elapsed().as_secs_f64() * 1e3);
+            last = Some(branch);
+        }
+        Ok((median(walls), median(cpus), last.expect("one run")))
+    };
+    let (wall_hb, cpu_hb, plain) = run(None)?;
+    let (wall, cpu, branch) = run(Some(FloquetOptions::default()))?;
+    let points = branch.points.len();
+    if std::env::var("DUMP").is_ok() {
+        dump(&branch);
+    }
+    let steps: Vec<usize> = branch
+        .points
+        .iter()
+        .filter_map(|p| p.floquet.as_ref().map(|f| f.steps))
+        .collect();
+    let first = steps.first().copied().unwrap_or(1).max(1) as f64;
+    let estimated = branch
+        .points
+        .iter()
+        .filter(|p| {
+            p.floquet
+                .as_ref()
+                .and_then(|f| f.reduction.as_ref())
+                .is_some_and(|r| r.estimate.is_some())
+        })
+        .count();
+    let unpolished = branch
+        .points
+        .iter()
+        .filter(|p| p.floquet.as_ref().is_some_and(|f| !f.polished))
+        .count();
+    println!("## Run-up sweep with stability: {path}\n");
+    println!(
+        "{} points with stability ({} without), Ω {:.1} → {:.1} rad/s, max step {}\n",
+        points,
+        plain.points.len(),
+        from,
+        to,
+        flag(&args, "--max-step", 1.0)
+    );
+    println!("| | wall ms | CPU ms | per point (CPU) ms |");
+    println!("|---|---:|---:|---:|");
+    println!(
+        "| continuation without stability | {wall_hb:.0} | {cpu_hb:.0} | {:.1} |",
+        cpu_hb / plain.points.len() as f64
+    );
+    println!(
+        "| continuation with stability | {wall:.0} | {cpu:.0} | {:.1} |",
+        cpu / points as f64
+    );
+    println!(
+        "| stability share (difference) | {:.0} | {:.0} | {:.1} |",
+        wall - wall_hb,
+        cpu - cpu_hb,
+        (cpu - cpu_hb) / points as f64
+    );
+    let mean = steps.iter().sum::<usize>() as f64 / steps.len().max(1) as f64;
+    println!(
+        "\nintegration steps per point: first {first:.0}, mean {mean:.0} ({:.2} of the first), \
+         max {}; {estimated} point(s) with the reduction's estimate; {unpolished} not polished",
+        mean / first,
+        steps.iter().max().unwrap_or(&0)
+    );
+    let max_mu = branch
+        .points
+        .iter()
+        .filter_map(|p| p.floquet.as_ref().map(|f| f.max_abs()))
+        .fold(0.0, f64::max);
+    println!(
+        "largest |μ| along the branch {max_mu:.9}; unstable points {}",
+        branch
+            .points
+            .iter()
+            .filter(|p| p.stable() == Some(false))
+            .count()
+    );
+    Ok(())
+}
+#[allow(dead_code)]
+fn dump(branch: &Branch) {
+    for p in &branch.points {
+        if let Some(f) = &p.floquet {
+            eprintln!(
+                "{:.2} steps {} corr {:.2e}",
+                p.omega, f.steps, f.orbit_correction
+            );
+        }
+    }
+}
