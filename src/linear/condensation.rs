@@ -28,7 +28,18 @@ pub struct Condensation {
     /// A name per coordinate (`u(element)`).
     names: Vec<String>,
     z: SparseDynamicStiffness,
+    /// `X_k = Z_k⁻¹ [W | F_k]` (n × (m+1), column-major) per harmonic of the last
+    /// [`linear_part`](Self::linear_part), kept where every `Z_k` is symmetric and they fit in
+    /// [`MAX_KEPT_BYTES`]: [`recover`](Self::recover) and
+    /// [`omega_derivative`](Self::omega_derivative) then need no solve.
+    solved: Vec<Vec<Complex64>>,
+    /// The full load `F` the kept solutions were made with.
+    solved_load: Vec<Complex64>,
 }
+
+/// The most memory the solved columns `Z_k⁻¹ [W | F_k]` may take (beyond it, each recovery
+/// and Ω-derivative solves again).
+pub const MAX_KEPT_BYTES: usize = 128 << 20;
 
 /// The condensed linear part on one basis: `G_k⁻¹` per harmonic and the condensed load.
 #[derive(Debug, Clone)]
@@ -85,6 +96,8 @@ impl Condensation {
                 coordinates,
                 names,
                 z,
+                solved: Vec::new(),
+                solved_load: Vec::new(),
             },
             map,
         ))
@@ -110,27 +123,44 @@ impl Condensation {
         self.z.rigid_modes()
     }
 
-    /// Factors `Z_k` for another Ω.
+    /// Factors `Z_k` for another Ω (each harmonic's factor is verified by the next
+    /// [`linear_part`](Self::linear_part), which must follow).
     pub fn refactor(&mut self, basis: &HarmonicBasis) -> Result<()> {
-        self.z.refactor(basis)
+        self.solved.clear();
+        self.z.refactor_unverified(basis)
     }
 
     /// `G_k⁻¹` and the condensed load for the full load `f` (harmonic-major, `(H+1) n`).
-    pub fn linear_part(&self, f: &[Complex64]) -> Result<CondensedLinear> {
+    ///
+    /// One multi-column solve per harmonic, `Z_k⁻¹ [W | F_k | b]`: the receptance, the linear
+    /// response and the test vector `b` that verifies the factor
+    /// ([`SparseDynamicStiffness::verify`]).
+    pub fn linear_part(&mut self, f: &[Complex64]) -> Result<CondensedLinear> {
         let (n, m) = (self.z.n(), self.len());
         let h = self.z.harmonics();
+        let keep = self.z.is_symmetric()
+            && (h + 1) * n * (m + 1) * std::mem::size_of::<Complex64>() <= MAX_KEPT_BYTES;
+        self.solved.clear();
         let mut stiffness = Vec::with_capacity(h + 1);
         let mut load = vec![Complex64::default(); (h + 1) * m];
-        let mut x = vec![Complex64::default(); n * (m + 1)];
+        let mut x = vec![Complex64::default(); n * (m + 2)];
         for k in 0..=h {
-            x.fill(Complex64::default());
-            for (c, w) in self.coordinates.iter().enumerate() {
-                for &(i, wi) in w {
-                    x[c * n + i] = Complex64::new(wi, 0.0);
+            loop {
+                x.fill(Complex64::default());
+                for (c, w) in self.coordinates.iter().enumerate() {
+                    for &(i, wi) in w {
+                        x[c * n + i] = Complex64::new(wi, 0.0);
+                    }
+                }
+                x[m * n..(m + 1) * n].copy_from_slice(&f[k * n..(k + 1) * n]);
+                for (xi, bi) in x[(m + 1) * n..].iter_mut().zip(self.z.test_vector()) {
+                    *xi = bi;
+                }
+                self.z.solve_in_place(k, &mut x, m + 2);
+                if self.z.verify(k, &x[(m + 1) * n..])? {
+                    break;
                 }
             }
-            x[m * n..].copy_from_slice(&f[k * n..(k + 1) * n]);
-            self.z.solve_in_place(k, &mut x, m + 1);
             let g = DMatrix::from_fn(m, m, |r, c| self.gather(r, &x[c * n..(c + 1) * n]));
             let u_lin: Vec<Complex64> = (0..m)
                 .map(|r| self.gather(r, &x[m * n..(m + 1) * n]))
@@ -151,8 +181,20 @@ impl Condensation {
                 load[k * m + r] = (0..m).map(|c| inv[(r, c)] * u_lin[c]).sum();
             }
             stiffness.push(inv);
+            if keep {
+                self.solved.push(x[..(m + 1) * n].to_vec());
+            }
+        }
+        if keep {
+            self.solved_load = f.to_vec();
         }
         Ok(CondensedLinear { stiffness, load })
+    }
+
+    /// The kept `Z_k⁻¹ [W | F_k]` of every harmonic, if kept for the full load `f`.
+    fn kept(&self, f: &[Complex64]) -> Option<&[Vec<Complex64>]> {
+        (self.solved.len() == self.z.harmonics() + 1 && self.solved_load == f)
+            .then_some(&self.solved[..])
     }
 
     /// The full harmonics `Q_k = Z_k⁻¹ (F_k - W R_k)` from the full load `f` and the
@@ -160,6 +202,21 @@ impl Condensation {
     pub fn recover(&self, f: &[Complex64], rest: &[Complex64]) -> Vec<Complex64> {
         let (n, m) = (self.z.n(), self.len());
         let h = self.z.harmonics();
+        if let Some(solved) = self.kept(f) {
+            // Q_k = Z_k⁻¹ F_k - Σ_c R_kc Z_k⁻¹ W[:, c].
+            let mut q = vec![Complex64::default(); (h + 1) * n];
+            for (k, x) in solved.iter().enumerate() {
+                let block = &mut q[k * n..(k + 1) * n];
+                block.copy_from_slice(&x[m * n..(m + 1) * n]);
+                for c in 0..m {
+                    let r = rest[k * m + c];
+                    for (qi, xi) in block.iter_mut().zip(&x[c * n..(c + 1) * n]) {
+                        *qi -= r * xi;
+                    }
+                }
+            }
+            return q;
+        }
         let mut q = f.to_vec();
         for k in 0..=h {
             let block = &mut q[k * n..(k + 1) * n];
@@ -180,7 +237,7 @@ impl Condensation {
     /// `y_k = Z_k⁻¹ (F_k + W G_k⁻¹ (U_k - U_lin,k))`,
     ///
     /// from `dG/dΩ = -Wᵀ Z⁻¹ (dZ/dΩ) Z⁻¹ W` and `dZ⁻¹/dΩ = -Z⁻¹ (dZ/dΩ) Z⁻¹` (at a solution
-    /// `y_k` is the full `Q_k`). Two sparse solves per harmonic. `g_inv` holds the `G_k⁻¹`,
+    /// `y_k` is the full `Q_k`). Two sparse solves per harmonic, or none with the kept solutions. `g_inv` holds the `G_k⁻¹`,
     /// `load` the condensed load `G_k⁻¹ U_lin,k`, `f` the full load.
     #[allow(clippy::too_many_arguments)]
     pub fn omega_derivative(
@@ -198,6 +255,7 @@ impl Condensation {
         let mut y = vec![Complex64::default(); n];
         let mut t = vec![Complex64::default(); n];
         let mut a = vec![Complex64::default(); m];
+        let kept = self.kept(f);
         for k in 0..=h {
             let gi = g_inv.matrix(k);
             // a = G⁻¹ (U - U_lin) = G⁻¹ U - load.
@@ -205,18 +263,37 @@ impl Condensation {
                 a[r] =
                     (0..m).map(|c| gi[(r, c)] * u[k * m + c]).sum::<Complex64>() - load[k * m + r];
             }
-            y.copy_from_slice(&f[k * n..(k + 1) * n]);
-            for (c, w) in self.coordinates.iter().enumerate() {
-                for &(i, wi) in w {
-                    y[i] += a[c] * wi;
+            if let Some(x) = kept.map(|s| &s[k]) {
+                // y = Z⁻¹F + Σ_c a_c Z⁻¹W[:, c]; Wᵀ Z⁻¹ t = (Z⁻¹W)ᵀ t (Z symmetric).
+                y.copy_from_slice(&x[m * n..(m + 1) * n]);
+                for (c, &ac) in a.iter().enumerate() {
+                    for (yi, xi) in y.iter_mut().zip(&x[c * n..(c + 1) * n]) {
+                        *yi += ac * xi;
+                    }
                 }
-            }
-            self.z.solve_in_place(k, &mut y, 1);
-            self.z
-                .apply_omega_derivative(k as f64 / nu as f64, omega, &y, &mut t);
-            self.z.solve_in_place(k, &mut t, 1);
-            for (r, ar) in a.iter_mut().enumerate() {
-                *ar = self.gather(r, &t);
+                self.z
+                    .apply_omega_derivative(k as f64 / nu as f64, omega, &y, &mut t);
+                for (c, ac) in a.iter_mut().enumerate() {
+                    *ac = x[c * n..(c + 1) * n]
+                        .iter()
+                        .zip(&t)
+                        .map(|(xi, ti)| xi * ti)
+                        .sum();
+                }
+            } else {
+                y.copy_from_slice(&f[k * n..(k + 1) * n]);
+                for (c, w) in self.coordinates.iter().enumerate() {
+                    for &(i, wi) in w {
+                        y[i] += a[c] * wi;
+                    }
+                }
+                self.z.solve_in_place(k, &mut y, 1);
+                self.z
+                    .apply_omega_derivative(k as f64 / nu as f64, omega, &y, &mut t);
+                self.z.solve_in_place(k, &mut t, 1);
+                for (r, ar) in a.iter_mut().enumerate() {
+                    *ar = self.gather(r, &t);
+                }
             }
             for r in 0..m {
                 out[k * m + r] = (0..m).map(|c| gi[(r, c)] * a[c]).sum();

@@ -42,6 +42,8 @@ pub struct SparseDynamicStiffness {
     shift: f64,
     /// Rigid-body modes of a free-free model: harmonic 0 solves in their complement.
     rigid: Option<std::sync::Arc<crate::model::RigidModes>>,
+    /// `M`, `D0`, `K0` symmetric (to 1e-13): every `Z_k` is complex symmetric, `Z_kᵀ = Z_k`.
+    symmetric: bool,
 }
 
 impl std::fmt::Debug for SparseDynamicStiffness {
@@ -94,7 +96,7 @@ impl SparseDynamicStiffness {
     pub fn shifted_static(pattern: SparsePattern, shift: f64) -> Result<Self> {
         let mut s = Self::ordered(pattern, 0.0);
         s.shift = shift;
-        let f = s.factor(0, 0.0)?;
+        let f = s.factor(0, 0.0, true)?;
         s.factors.push(f);
         Ok(s)
     }
@@ -111,7 +113,8 @@ impl SparseDynamicStiffness {
     /// The ordering (envelope or none), nothing factored yet.
     fn ordered(pattern: SparsePattern, fundamental: f64) -> Self {
         let n = pattern.n;
-        let envelope = pattern.is_symmetric().then(|| {
+        let symmetric = pattern.is_symmetric();
+        let envelope = symmetric.then(|| {
             let (col_ptr, row_idx) = (&pattern.col_ptr, &pattern.row_idx);
             let entries = (0..n)
                 .flat_map(move |j| (col_ptr[j]..col_ptr[j + 1]).map(move |p| (row_idx[p], j)));
@@ -134,22 +137,64 @@ impl SparseDynamicStiffness {
             work: RefCell::new(vec![Complex64::default(); n]),
             shift: 0.0,
             rigid: None,
+            symmetric,
         }
     }
 
     /// Factors `Z_k` again for another Ω (same ordering, same symbolic analysis).
     pub fn refactor(&mut self, basis: &HarmonicBasis) -> Result<()> {
+        self.refactor_checked(basis, true)
+    }
+
+    /// [`refactor`](Self::refactor) without the test solve of every envelope factor above
+    /// harmonic 0: the caller solves [`test_vector`](Self::test_vector) among its own
+    /// right-hand sides and hands the result to [`verify`](Self::verify) before using a
+    /// harmonic's factor (one more column in a multi-column solve instead of a solve of its
+    /// own).
+    pub fn refactor_unverified(&mut self, basis: &HarmonicBasis) -> Result<()> {
+        self.refactor_checked(basis, false)
+    }
+
+    fn refactor_checked(&mut self, basis: &HarmonicBasis, verify: bool) -> Result<()> {
         self.fundamental = basis.fundamental();
         self.factors.clear();
         for k in 0..=basis.harmonics() {
-            let f = self.factor(k, k as f64 * self.fundamental)?;
+            let f = self.factor(k, k as f64 * self.fundamental, verify || k == 0)?;
             self.factors.push(f);
         }
         Ok(())
     }
 
+    /// The right-hand side `b = (1, 2, …, n)` of the backward-error test.
+    pub fn test_vector(&self) -> impl Iterator<Item = Complex64> {
+        (0..self.pattern.n).map(|i| Complex64::new(1.0 + i as f64, 0.0))
+    }
+
+    /// Checks harmonic `k`'s factor with `x = Z_k⁻¹ b` solved by the caller for the
+    /// [`test_vector`](Self::test_vector) `b`: `Ok(true)` if its backward error is below
+    /// the threshold (or the factor was checked when it was made); otherwise `Z_k` is factored
+    /// again by the pivoting LU (checked) and `Ok(false)` asks the caller to solve again.
+    pub fn verify(&mut self, k: usize, x: &[Complex64]) -> Result<bool> {
+        if k == 0 || matches!(self.factors[k], Factor::Lu(_)) {
+            return Ok(true);
+        }
+        let w = k as f64 * self.fundamental;
+        let values = self.pattern.values(w, 0.0);
+        if self.backward_error_of(x, w, 0.0, &values) < SINGULAR_RESIDUAL {
+            return Ok(true);
+        }
+        self.factors[k] = self.lu_checked(k, w, values)?;
+        Ok(false)
+    }
+
+    /// `Z_kᵀ = Z_k` for every k (symmetric `M`, `D0`, `K0`), so that
+    /// `Wᵀ Z_k⁻¹ v = (Z_k⁻¹ W)ᵀ v`.
+    pub fn is_symmetric(&self) -> bool {
+        self.symmetric
+    }
+
     /// The factor of `Z_k` at `w = kΩ` (`K0 + σM` at k = 0).
-    fn factor(&mut self, k: usize, w: f64) -> Result<Factor> {
+    fn factor(&mut self, k: usize, w: f64, verify: bool) -> Result<Factor> {
         {
             let s = if k == 0 { self.shift } else { 0.0 };
             let values = self.pattern.values(w, s);
@@ -167,28 +212,31 @@ impl SparseDynamicStiffness {
                 }
                 if env.factor(&mut v) {
                     let f = Factor::Envelope(v);
-                    if self.backward_error(&f, w, s, &values) < SINGULAR_RESIDUAL {
+                    if !verify || self.backward_error(&f, w, s, &values) < SINGULAR_RESIDUAL {
                         factor = Some(f);
                     }
                 }
             }
-            let factor = match factor {
-                Some(f) => f,
-                None => {
-                    let f = self.lu(values.clone()).ok_or_else(|| singular(k, w, 0.0))?;
-                    let rel = self.backward_error(&f, w, s, &values);
-                    if rel.is_nan() || rel >= SINGULAR_RESIDUAL {
-                        return Err(singular(
-                            k,
-                            w,
-                            if rel.is_finite() { 1.0 / rel } else { 0.0 },
-                        ));
-                    }
-                    f
-                }
-            };
-            Ok(factor)
+            match factor {
+                Some(f) => Ok(f),
+                None => self.lu_checked(k, w, values),
+            }
         }
+    }
+
+    /// faer's pivoting LU of `values` (`Z_k` at `w`), rejected by its backward error.
+    fn lu_checked(&mut self, k: usize, w: f64, values: Vec<Complex64>) -> Result<Factor> {
+        let s = if k == 0 { self.shift } else { 0.0 };
+        let f = self.lu(values.clone()).ok_or_else(|| singular(k, w, 0.0))?;
+        let rel = self.backward_error(&f, w, s, &values);
+        if rel.is_nan() || rel >= SINGULAR_RESIDUAL {
+            return Err(singular(
+                k,
+                w,
+                if rel.is_finite() { 1.0 / rel } else { 0.0 },
+            ));
+        }
+        Ok(f)
     }
 
     /// faer's LU of the values on the pattern (symbolic analysis on first use).
@@ -206,14 +254,17 @@ impl SparseDynamicStiffness {
 
     /// The backward error of solving with `f` for `b = (1, 2, ..., n)`.
     fn backward_error(&self, f: &Factor, w: f64, s: f64, values: &[Complex64]) -> f64 {
-        let n = self.pattern.n;
-        let b: Vec<Complex64> = (0..n)
-            .map(|i| Complex64::new(1.0 + i as f64, 0.0))
-            .collect();
-        let mut x = b.clone();
+        let mut x: Vec<Complex64> = self.test_vector().collect();
         self.solve_with(f, &mut x, 1);
+        self.backward_error_of(&x, w, s, values)
+    }
+
+    /// The backward error of `x` as the solution for the test vector.
+    fn backward_error_of(&self, x: &[Complex64], w: f64, s: f64, values: &[Complex64]) -> f64 {
+        let n = self.pattern.n;
+        let b: Vec<Complex64> = self.test_vector().collect();
         let mut back = vec![Complex64::default(); n];
-        self.pattern.apply(w, s, &x, &mut back);
+        self.pattern.apply(w, s, x, &mut back);
         let norm = |v: &[Complex64]| v.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
         let err = back
             .iter()
@@ -221,7 +272,7 @@ impl SparseDynamicStiffness {
             .map(|(a, c)| (a - c).norm_sqr())
             .sum::<f64>()
             .sqrt();
-        let rel = err / (norm(values) * norm(&x) + norm(&b));
+        let rel = err / (norm(values) * norm(x) + norm(&b));
         if rel.is_finite() {
             rel
         } else {

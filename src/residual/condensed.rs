@@ -11,7 +11,7 @@ impl HarmonicBalance<'_> {
     /// Condenses onto the element coordinates at the current basis (again after a change
     /// of Ω): `G_k⁻¹` becomes the dynamic stiffness and the condensed load the load.
     pub(crate) fn condense(&mut self) -> Result<()> {
-        let (cond, f_full) = match self.condensed.take() {
+        let (mut cond, f_full) = match self.condensed.take() {
             Some(b) => {
                 let (mut c, f) = *b;
                 c.refactor(&self.basis)?;
