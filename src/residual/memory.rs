@@ -9,7 +9,8 @@
 //! harmonics: one FFT per column. It is a general `(2H+1)²` matrix, not the Toeplitz-like
 //! block of a memoryless law.
 
-use super::{scatter_add, ActiveElement, AftBuffers, HarmonicBalance};
+use super::aft::{scatter_add, ActiveElement};
+use super::{AftBuffers, HarmonicBalance};
 use crate::error::{Error, Result};
 use crate::force::{Hysteresis, LinearPart};
 use crate::harmonic::march::{march, NotClosed};
