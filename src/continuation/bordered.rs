@@ -219,6 +219,9 @@ impl Continuation {
             g += target.row[m] * (*o - target.op) / sc.so;
             b.rhs[m] = -g;
             lu::solve_in_place(&b.big, &b.perm, &mut b.rhs);
+            if it >= 1 && rel <= HOLD_OMEGA_RESIDUAL {
+                hold_omega(b);
+            }
             for i in 0..m {
                 x[i] += b.rhs[i] * sc.sx;
             }
@@ -282,4 +285,31 @@ pub(super) fn tangent(b: &mut Bordered, t: &mut [f64]) {
     for (ti, v) in t.iter_mut().zip(&b.rhs) {
         *ti = v / norm;
     }
+}
+
+/// The relative residual below which a corrector iteration after the first keeps Ω
+/// ([`hold_omega`]): close enough to the branch that Newton at fixed Ω cannot reach another
+/// branch at the same Ω (a fold's other side).
+const HOLD_OMEGA_RESIDUAL: f64 = 1e-6;
+
+/// Turns the corrector step `δ = B⁻¹ [-R; c]` in `b.rhs` into the step at fixed Ω,
+/// `R_x δx = -R`, where the branch is far from a turning point: `δ - (δ_Ω / τ_Ω) τ` with
+/// `τ = B⁻¹ [0; 1]` (the same factors), so that `δ_Ω = 0`. After the first iteration the Ω
+/// the corrector reached is kept: the next iteration then needs no new `Z_k` (in the condensed
+/// formulation a refactorisation of every harmonic). Near a turning point (`|τ_Ω|` below a
+/// quarter of `‖τ‖`) the step stays on the arclength hyperplane.
+fn hold_omega(b: &mut Bordered) {
+    let m = b.layout.len();
+    let mut tau = vec![0.0; m + 1];
+    tau[m] = 1.0;
+    lu::solve_in_place(&b.big, &b.perm, &mut tau);
+    let norm = tau.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if !(tau[m].abs() >= 0.25 * norm && norm.is_finite()) {
+        return;
+    }
+    let c = b.rhs[m] / tau[m];
+    for (d, t) in b.rhs.iter_mut().zip(&tau) {
+        *d -= c * t;
+    }
+    b.rhs[m] = 0.0;
 }

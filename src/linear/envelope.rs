@@ -160,32 +160,41 @@ impl Envelope {
                 work[new * columns + c] = x[c * n + old];
             }
         }
-        // L y = b.
+        let work = &mut work[..n * columns];
+        // L y = b: row i takes the finished rows k < i of its envelope.
         for i in 0..n {
             let (fi, si) = (self.first[i], self.start[i]);
-            for k in fi..i {
-                let l = values[si + (k - fi)];
-                for c in 0..columns {
-                    let v = work[k * columns + c];
-                    work[i * columns + c] -= l * v;
+            let (done, rest) = work.split_at_mut(i * columns);
+            let row = &mut rest[..columns];
+            let coefficients = &values[si..si + (i - fi)];
+            for (l, src) in coefficients
+                .iter()
+                .zip(done[fi * columns..].chunks_exact(columns))
+            {
+                for (r, v) in row.iter_mut().zip(src) {
+                    *r -= l * v;
                 }
             }
         }
         // D z = y.
-        for i in 0..n {
+        for (i, row) in work.chunks_exact_mut(columns).enumerate() {
             let inv = values[self.start[i] + (i - self.first[i])];
-            for c in 0..columns {
-                work[i * columns + c] *= inv;
+            for r in row.iter_mut() {
+                *r *= inv;
             }
         }
-        // Lᵀ x = z, from the last row.
+        // Lᵀ x = z, from the last row: row i, final, updates the rows k < i of its envelope.
         for i in (0..n).rev() {
             let (fi, si) = (self.first[i], self.start[i]);
-            for k in fi..i {
-                let l = values[si + (k - fi)];
-                for c in 0..columns {
-                    let v = work[i * columns + c];
-                    work[k * columns + c] -= l * v;
+            let (head, rest) = work.split_at_mut(i * columns);
+            let row = &rest[..columns];
+            let coefficients = &values[si..si + (i - fi)];
+            for (l, dst) in coefficients
+                .iter()
+                .zip(head[fi * columns..].chunks_exact_mut(columns))
+            {
+                for (d, v) in dst.iter_mut().zip(row) {
+                    *d -= l * v;
                 }
             }
         }
