@@ -134,32 +134,27 @@ impl Condensation {
     ///
     /// One multi-column solve per harmonic, `Z_k⁻¹ [W | F_k | b]`: the receptance, the linear
     /// response and the test vector `b` that verifies the factor
-    /// ([`SparseDynamicStiffness::verify`]).
+    /// ([`SparseDynamicStiffness::verify`]); the harmonics on the cores
+    /// ([`parallel`](super::parallel)).
     pub fn linear_part(&mut self, f: &[Complex64]) -> Result<CondensedLinear> {
         let (n, m) = (self.z.n(), self.len());
         let h = self.z.harmonics();
         let keep = self.z.is_symmetric()
             && (h + 1) * n * (m + 1) * std::mem::size_of::<Complex64>() <= MAX_KEPT_BYTES;
         self.solved.clear();
+        let this = &*self;
+        let threads = super::parallel::threads(n * (h + 1));
+        let solved = super::parallel::map(h + 1, threads, |k| {
+            let x = this.solve_harmonic(k, f);
+            let passed = this.z.check(k, &x[(m + 1) * n..]);
+            (x, passed)
+        });
         let mut stiffness = Vec::with_capacity(h + 1);
         let mut load = vec![Complex64::default(); (h + 1) * m];
-        let mut x = vec![Complex64::default(); n * (m + 2)];
-        for k in 0..=h {
-            loop {
-                x.fill(Complex64::default());
-                for (c, w) in self.coordinates.iter().enumerate() {
-                    for &(i, wi) in w {
-                        x[c * n + i] = Complex64::new(wi, 0.0);
-                    }
-                }
-                x[m * n..(m + 1) * n].copy_from_slice(&f[k * n..(k + 1) * n]);
-                for (xi, bi) in x[(m + 1) * n..].iter_mut().zip(self.z.test_vector()) {
-                    *xi = bi;
-                }
-                self.z.solve_in_place(k, &mut x, m + 2);
-                if self.z.verify(k, &x[(m + 1) * n..])? {
-                    break;
-                }
+        for (k, (mut x, passed)) in solved.into_iter().enumerate() {
+            // A factor that failed its test: the pivoting LU, and that harmonic solved again.
+            if !passed && !self.z.verify(k, &x[(m + 1) * n..])? {
+                x = self.solve_harmonic(k, f);
             }
             let g = DMatrix::from_fn(m, m, |r, c| self.gather(r, &x[c * n..(c + 1) * n]));
             let u_lin: Vec<Complex64> = (0..m)
@@ -182,13 +177,32 @@ impl Condensation {
             }
             stiffness.push(inv);
             if keep {
-                self.solved.push(x[..(m + 1) * n].to_vec());
+                x.truncate((m + 1) * n);
+                self.solved.push(x);
             }
         }
         if keep {
             self.solved_load = f.to_vec();
         }
         Ok(CondensedLinear { stiffness, load })
+    }
+
+    /// `Z_k⁻¹ [W | F_k | b]` (n × (m+2), column-major), `b` the factor's test vector.
+    fn solve_harmonic(&self, k: usize, f: &[Complex64]) -> Vec<Complex64> {
+        let (n, m) = (self.z.n(), self.len());
+        let mut x = vec![Complex64::default(); n * (m + 2)];
+        for (c, w) in self.coordinates.iter().enumerate() {
+            for &(i, wi) in w {
+                x[c * n + i] = Complex64::new(wi, 0.0);
+            }
+        }
+        x[m * n..(m + 1) * n].copy_from_slice(&f[k * n..(k + 1) * n]);
+        for (xi, bi) in x[(m + 1) * n..].iter_mut().zip(self.z.test_vector()) {
+            *xi = bi;
+        }
+        let mut work = Vec::new();
+        self.z.solve_in_place_with(k, &mut x, m + 2, &mut work);
+        x
     }
 
     /// The kept `Z_k⁻¹ [W | F_k]` of every harmonic, if kept for the full load `f`.

@@ -4,6 +4,8 @@
 
 pub mod condensation;
 pub mod envelope;
+mod parallel;
+mod sparse_factor;
 pub mod sparse_pattern;
 pub mod sparse_stiffness;
 
