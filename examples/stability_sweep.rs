@@ -9,7 +9,8 @@
 //! speed unit, the continuation's default largest step (1.0; 0.0075 gives about 500 points),
 //! one run of each. Times are wall clock and this thread's CPU time (`/proc/thread-self`, on
 //! Linux; the machine may be shared), the medians over the repeats. No error estimate per
-//! point (the HB side of `hbal sweep --no-error-estimate`).
+//! point (the HB side of `hbal sweep --no-error-estimate`). With `DUMP` set in the environment,
+//! every point's Ω, steps, orbit correction, `polished` and multipliers go to stderr.
 
 use hbal::continuation::{Branch, Continuation};
 use hbal::scene::Scene;
@@ -147,9 +148,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 fn dump(branch: &Branch) {
     for p in &branch.points {
         if let Some(f) = &p.floquet {
+            let mu: Vec<String> = f
+                .multipliers
+                .iter()
+                .map(|m| format!("{:.15e},{:.15e}", m.re, m.im))
+                .collect();
             eprintln!(
-                "{:.2} steps {} corr {:.2e}",
-                p.omega, f.steps, f.orbit_correction
+                "{:.6} steps {} corr {:.2e} polished {} mu {}",
+                p.omega,
+                f.steps,
+                f.orbit_correction,
+                f.polished,
+                mu.join(" ")
             );
         }
     }
