@@ -22,9 +22,10 @@
 //!   `x̃(t+τ) = Σ τⁱ x̃⁽ⁱ⁾/i!`, `x̃⁽ⁱ⁺¹⁾ = Ã x̃⁽ⁱ⁾ + b̃⁽ⁱ⁾(t)`;
 //! * a kink crossing is detected on every sub-step from the cubic Hermite interpolant of `u` as
 //!   in the Runge–Kutta flow and located by Newton on the same Taylor series;
-//! * the monodromy matrix: one product per set bit of `m`, and `e^{Ãτ}` for the last part
-//!   (`τ = r`, or up to the crossing) by the Taylor polynomial, a linear combination of the kept
-//!   `Ãⁱ/i!`; at a crossing the saltation matrix of a force jump.
+//! * the monodromy matrix, afterwards and only for the orbits that need it, from the record of
+//!   the pass ([`record`](super::record)): one product per set bit of `m`, and `e^{Ãτ}` for the
+//!   last part (`τ = r`, or up to the crossing) by the Taylor polynomial, a linear combination
+//!   of the kept `Ãⁱ/i!`; at a crossing the saltation matrix of a force jump.
 //!
 //! The laws' coefficients are read at a fixed point inside each kink interval
 //! ([`Pieces::inside`]), so that equal pieces give bit-equal keys. At the end of every piece
@@ -35,6 +36,7 @@
 use super::expm::ExpWork;
 use super::generator::{Expansion, Forcing, State};
 use super::pieces::Pieces;
+use super::record::Step;
 use super::system::Coordinates;
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
@@ -42,26 +44,26 @@ use std::collections::HashMap;
 
 /// The flow over one period by exponentials.
 pub(crate) struct ExpFlow<'c, 'm> {
-    sys: &'c Coordinates<'m>,
+    pub(super) sys: &'c Coordinates<'m>,
     n: usize,
     omega: f64,
     bounds: Vec<f64>,
     pieces: Pieces,
-    scale_q: f64,
-    scale_v: f64,
+    pub(super) scale_q: f64,
+    pub(super) scale_v: f64,
     /// The sub-step δ₀ (a power of two).
     delta0: f64,
     max_steps: usize,
     /// `Ã` of the structure alone.
     base: DMatrix<f64>,
     /// `M⁻¹ w_e` (unscaled).
-    mw: Vec<DVector<f64>>,
+    pub(super) mw: Vec<DVector<f64>>,
     forcing: Forcing,
     /// The oscillator's turn over δ₀.
     turns: Vec<(f64, f64)>,
-    work: ExpWork,
+    pub(super) work: ExpWork,
     /// The generators met so far, and their index by the laws' coefficients.
-    states: Vec<State>,
+    pub(super) states: Vec<State>,
     index: HashMap<Vec<u64>, usize>,
     /// The Taylor series of the exact solution from the last expansion point.
     taylor: Expansion,
@@ -210,16 +212,15 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             })
     }
 
-    /// Integrates `y = (q, q̇, Φ̃)` over one period `[0, T]`. `Ok(false)`: a law is not affine
-    /// on its piece (`y` is then meaningless; use the Runge–Kutta flow).
-    pub(crate) fn period(&mut self, y: &mut [f64]) -> Result<bool> {
+    /// Integrates the state `y = (q, q̇)` over one period `[0, T]` and appends its pieces to
+    /// `record` (what [`ExpFlow::monodromy`] multiplies). `Ok(false)`: a law is not affine on
+    /// its piece (`y` is then meaningless; use the Runge–Kutta flow).
+    pub(crate) fn orbit(&mut self, y: &mut [f64], record: &mut Vec<Step>) -> Result<bool> {
         let n = self.n;
         let s2 = 2 * n;
         let mut x = DVector::from_fn(s2, |i, _| {
             y[i] / if i < n { self.scale_q } else { self.scale_v }
         });
-        let mut phi = DMatrix::from_column_slice(s2, s2, &y[s2..]);
-        let (mut e_tau, mut tmp) = (DMatrix::zeros(s2, s2), DMatrix::zeros(s2, s2));
         let mut z = DVector::zeros(self.forcing.states());
         let mut x_new = DVector::zeros(s2);
         let elements = self.mw.len();
@@ -287,20 +288,20 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                     }
                 };
                 self.steps += done + 1;
-                // Φ̃ ← e^{Ãτ} E_δ₀^done Φ̃.
-                let state = &mut self.states[piece.state];
-                state.advance(done, &mut phi, &mut tmp);
-                if tau > 0.0 {
-                    state.exp_short(tau, &mut e_tau, &mut self.work);
-                    tmp.gemm(1.0, &e_tau, &phi, 0.0);
-                    std::mem::swap(&mut phi, &mut tmp);
-                }
+                // For the monodromy matrix: Φ̃ ← e^{Ãτ} E_δ₀^done Φ̃.
+                record.push(Step::Piece {
+                    state: piece.state,
+                    whole: done,
+                    tau,
+                });
                 let end = if crossed.is_some() { t_sub + tau } else { tb };
                 if !self.still_affine(&piece, &x, angle(end)) {
                     return Ok(false);
                 }
                 if let Some((e, up)) = crossed {
-                    self.cross(e, up, angle(end), &x, &mut phi);
+                    if let Some(factor) = self.cross(e, up, angle(end), &x) {
+                        record.push(Step::Jump { element: e, factor });
+                    }
                 }
                 t = end;
             }
@@ -308,10 +309,9 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         for i in 0..s2 {
             y[i] = x[i] * if i < n { self.scale_q } else { self.scale_v };
         }
-        y[s2..].copy_from_slice(phi.as_slice());
-        if y.iter().any(|v| !v.is_finite()) {
+        if y[..s2].iter().any(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
-                what: "variational equation (exponential flow)".into(),
+                what: "orbit (exponential flow)".into(),
             });
         }
         Ok(true)
@@ -367,20 +367,12 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         tau
     }
 
-    /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`
-    /// ([`Pieces::cross_with_saltation`]).
-    fn cross(&mut self, e: usize, up: bool, theta: f64, x: &DVector<f64>, phi: &mut DMatrix<f64>) {
+    /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`: the
+    /// factor of the saltation matrix of its force jump ([`Pieces::cross_jump`]).
+    fn cross(&mut self, e: usize, up: bool, theta: f64, x: &DVector<f64>) -> Option<f64> {
         let (u, du) = self.element_state(e, x);
         let omega_s = self.scale_v / self.scale_q;
-        let mw = self.mw[e].as_slice();
-        self.pieces.cross_with_saltation(
-            self.sys,
-            e,
-            up,
-            (theta, u, du),
-            mw,
-            omega_s,
-            phi.as_mut_slice(),
-        );
+        self.pieces
+            .cross_jump(self.sys, e, up, (theta, u, du), omega_s)
     }
 }

@@ -64,17 +64,21 @@
 //! ```
 
 mod affine;
+mod chord;
 mod dispatch;
 mod dopri;
 mod expm;
 mod exponential;
 mod flow;
 mod generator;
+mod integration;
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
 mod pieces;
+mod record;
 mod reduction;
+mod scales;
 mod shooting;
 mod system;
 
