@@ -35,6 +35,7 @@
 
 use super::expm::ExpWork;
 use super::generator::{Expansion, Forcing, State};
+use super::kernels::gemv;
 use super::pieces::Pieces;
 use super::record::Step;
 use super::system::Coordinates;
@@ -252,8 +253,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 self.kink_states(&x, &mut at_start);
                 self.forcing.oscillator(t, &mut z);
                 for _ in 0..whole as usize {
-                    x_new.gemv(1.0, state.e0(), &x, 0.0);
-                    x_new.gemv(1.0, &state.x0, &z, 1.0);
+                    gemv(state.e0(), x.as_slice(), x_new.as_mut_slice(), false);
+                    gemv(&state.x0, z.as_slice(), x_new.as_mut_slice(), true);
                     self.kink_states(&x_new, &mut at_end);
                     hit = self.first_crossing(&at_start, &at_end, delta0);
                     if hit.is_some() {

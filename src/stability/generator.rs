@@ -19,6 +19,7 @@
 //! monodromy matrix cost one product per set bit of `m`.
 
 use super::expm::{inverse_factorial, phi_narrow, squarings, ExpWork, Powers};
+use super::kernels::{gemv, horner, product};
 use super::system::Coordinates;
 use nalgebra::{DMatrix, DVector};
 
@@ -34,6 +35,8 @@ pub(crate) struct Forcing {
     dirs: DMatrix<f64>,
     /// `C Sʲ`, `j = 0..=MAX_DEGREE`.
     channels: Vec<DMatrix<f64>>,
+    /// `G C` (n × oscillator states).
+    load: DMatrix<f64>,
     /// `S`.
     generator: DMatrix<f64>,
 }
@@ -78,11 +81,13 @@ impl Forcing {
             let next = &channels[j - 1] * &generator;
             channels.push(next);
         }
+        let load = &dirs * &channels[0];
         Self {
             omega,
             orders,
             dirs,
             channels,
+            load,
             generator,
         }
     }
@@ -144,15 +149,7 @@ impl Forcing {
     /// `out += G C w` for the oscillator vector `w` (the load's velocity rows; `w = Sⁱ z` gives
     /// its `i`-th time derivative).
     pub(crate) fn add_load(&self, w: &DVector<f64>, out: &mut [f64]) {
-        let c = &self.channels[0];
-        for d in 0..c.nrows() {
-            let v = c.row(d).dot(&w.transpose());
-            if v != 0.0 {
-                for (o, g) in out.iter_mut().zip(self.dirs.column(d).iter()) {
-                    *o += v * g;
-                }
-            }
-        }
+        gemv(&self.load, w.as_slice(), out, true);
     }
 
     /// `w ← S w` (each pair `(c, s)` of order `k` becomes `kΩ (-s, c)`, the constant 0).
@@ -269,12 +266,7 @@ impl State {
         let degree = (1..16)
             .find(|&d| x.powi(d as i32 + 1) * inverse_factorial(d + 1) < 1e-16)
             .unwrap_or(16);
-        out.copy_from(&self.terms[degree]);
-        for term in self.terms[..degree].iter().rev() {
-            for (o, t) in out.as_mut_slice().iter_mut().zip(term.as_slice()) {
-                *o = *o * tau + t;
-            }
-        }
+        horner(&self.terms[..=degree], tau, out);
     }
 
     /// `E_δ₀`.
@@ -288,11 +280,12 @@ impl State {
         while k >> j != 0 {
             if j == self.ladder.len() {
                 let last = &self.ladder[j - 1];
-                let next = last * last;
+                let mut next = DMatrix::zeros(last.nrows(), last.ncols());
+                product(last, last, &mut next);
                 self.ladder.push(next);
             }
             if (k >> j) & 1 == 1 {
-                tmp.gemm(1.0, &self.ladder[j], phi, 0.0);
+                product(&self.ladder[j], phi, tmp);
                 std::mem::swap(phi, tmp);
             }
             j += 1;
@@ -337,7 +330,12 @@ impl Expansion {
             }
             let (done, next) = self.derivs.split_at_mut(i + 1);
             let next = &mut next[0];
-            next.gemv(1.0, &state.powers.a, &done[i], 0.0);
+            gemv(
+                &state.powers.a,
+                done[i].as_slice(),
+                next.as_mut_slice(),
+                false,
+            );
             let v = &mut next.as_mut_slice()[n..];
             forcing.add_load(&z, v);
             forcing.differentiate(&mut z);

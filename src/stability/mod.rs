@@ -72,6 +72,7 @@ mod exponential;
 mod flow;
 mod generator;
 mod integration;
+mod kernels;
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;

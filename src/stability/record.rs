@@ -15,6 +15,7 @@
 //! ([`chord`](super::chord)) need it once per point.
 
 use super::exponential::ExpFlow;
+use super::kernels::product;
 use super::pieces::saltation;
 use crate::error::{Error, Result};
 use nalgebra::DMatrix;
@@ -46,7 +47,7 @@ impl ExpFlow<'_, '_> {
                     state.advance(whole, &mut phi, &mut tmp);
                     if tau > 0.0 {
                         state.exp_short(tau, &mut e_tau, &mut self.work);
-                        tmp.gemm(1.0, &e_tau, &phi, 0.0);
+                        product(&e_tau, &phi, &mut tmp);
                         std::mem::swap(&mut phi, &mut tmp);
                     }
                 }
