@@ -37,7 +37,7 @@ use super::expm::ExpWork;
 use super::generator::{Expansion, Forcing, State};
 use super::kernels::gemv;
 use super::pieces::Pieces;
-use super::record::Step;
+use super::record::{Assembler, Step};
 use super::system::Coordinates;
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
@@ -45,24 +45,24 @@ use std::collections::HashMap;
 
 /// The flow over one period by exponentials.
 pub(crate) struct ExpFlow<'c, 'm> {
-    pub(super) sys: &'c Coordinates<'m>,
+    sys: &'c Coordinates<'m>,
     n: usize,
     omega: f64,
     bounds: Vec<f64>,
     pieces: Pieces,
-    pub(super) scale_q: f64,
-    pub(super) scale_v: f64,
+    scale_q: f64,
+    scale_v: f64,
     /// The sub-step δ₀ (a power of two).
     delta0: f64,
     max_steps: usize,
     /// `Ã` of the structure alone.
     base: DMatrix<f64>,
     /// `M⁻¹ w_e` (unscaled).
-    pub(super) mw: Vec<DVector<f64>>,
+    mw: Vec<DVector<f64>>,
     forcing: Forcing,
     /// The oscillator's turn over δ₀.
     turns: Vec<(f64, f64)>,
-    pub(super) work: ExpWork,
+    work: ExpWork,
     /// The generators met so far, and their index by the laws' coefficients.
     pub(super) states: Vec<State>,
     index: HashMap<Vec<u64>, usize>,
@@ -70,6 +70,8 @@ pub(crate) struct ExpFlow<'c, 'm> {
     taylor: Expansion,
     /// Integration steps (sub-steps and remainders) over all periods.
     pub(crate) steps: usize,
+    /// The monodromy side.
+    pub(super) assembler: Assembler,
 }
 
 /// A piece: its generator and the laws' coefficients `(f0_e, k_e, d_e)`.
@@ -107,7 +109,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             .copy_from(&(-(&m_inv * &sys.stiffness) / omega_s));
         base.view_mut((n, n), (n, n))
             .copy_from(&(-(&m_inv * &sys.damping)));
-        let mw = sys
+        let mw: Vec<DVector<f64>> = sys
             .weights
             .iter()
             .map(|w| {
@@ -120,6 +122,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         let fastest = omega_max.max(omega).max(forcing.top());
         let delta0 = f64::powi(2.0, -(fastest.log2().ceil() as i32));
         let turns = forcing.turns(delta0);
+        let assembler = Assembler::new(2 * n, &sys.weights, &mw);
         Ok(Self {
             sys,
             n,
@@ -139,6 +142,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             index: HashMap::new(),
             taylor: Expansion::default(),
             steps: 0,
+            assembler,
         })
     }
 

@@ -95,7 +95,7 @@ impl Pieces {
         phi: &mut [f64],
     ) {
         if let Some(factor) = self.cross_jump(sys, e, up, at, omega_s) {
-            saltation(sys, e, factor, mw, phi);
+            saltation(&sys.weights[e], factor, mw, phi);
         }
     }
 
@@ -224,13 +224,13 @@ impl Pieces {
     }
 }
 
-/// `Φ̃ ← S Φ̃` for the saltation matrix of a force jump of element `e` with factor `c`
-/// ([`Pieces::cross_jump`]): every column gets `δṽ += c M⁻¹ w_e (w̃_e·δq̃)` (`mw` = `M⁻¹ w_e`,
-/// `phi` column-major with `2n` rows).
-pub(crate) fn saltation(sys: &Coordinates, e: usize, factor: f64, mw: &[f64], phi: &mut [f64]) {
+/// `Φ̃ ← S Φ̃` for the saltation matrix of a force jump of an element with weights `w̃_e`
+/// (`weights`) and factor `c` ([`Pieces::cross_jump`]): every column gets
+/// `δṽ += c M⁻¹ w_e (w̃_e·δq̃)` (`mw` = `M⁻¹ w_e`, `phi` column-major with `2n` rows).
+pub(crate) fn saltation(weights: &[(usize, f64)], factor: f64, mw: &[f64], phi: &mut [f64]) {
     let n = mw.len();
     for col in phi.chunks_exact_mut(2 * n) {
-        let wq = sys.gather(e, &col[..n]);
+        let wq: f64 = weights.iter().map(|&(i, w)| col[i] * w).sum();
         for (c, m) in col[n..].iter_mut().zip(mw) {
             *c += factor * m * wq;
         }

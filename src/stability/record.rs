@@ -8,17 +8,20 @@
 //!
 //! `Φ̃ = … S_k e^{Ã_k τ_k} E_k^{m_k} … S_1 e^{Ã_1 τ_1} E_1^{m_1}`
 //!
-//! (`E = e^{Ãδ₀}` by its ladder `E^{2^j}`, one product per set bit of `m`; `e^{Ãτ}` by the
-//! Taylor polynomial of the kept `Ãⁱ/i!`; `S` the saltation matrices): the same products in the
-//! same order as integrating `Φ̃` along the pass, so the same matrix to the last bit. Only the
+//! (`E^m = e^{Ãmδ₀}` and `e^{Ãτ}` per generator from its [`Propagator`], `S` the saltation
+//! matrices), multiplied by the [`Assembler`] step by step in the pass's order. Only the
 //! orbits whose monodromy matrix is used pay for it: the shooting's Newton–chord iterations
 //! ([`chord`](super::chord)) need it once per point.
 
+use super::expm::ExpWork;
 use super::exponential::ExpFlow;
+use super::generator::Core;
 use super::kernels::product;
 use super::pieces::saltation;
+use super::propagator::Propagator;
 use crate::error::{Error, Result};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 
 /// One factor of the monodromy matrix of a pass.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,34 +37,96 @@ pub(crate) enum Step {
     Jump { element: usize, factor: f64 },
 }
 
-impl ExpFlow<'_, '_> {
-    /// The scaled monodromy matrix `Φ̃` of the pass that wrote `record`.
-    pub(crate) fn monodromy(&mut self, record: &[Step]) -> Result<DMatrix<f64>> {
-        let s2 = 2 * self.sys.len();
-        let mut phi = DMatrix::identity(s2, s2);
-        let (mut e_tau, mut tmp) = (DMatrix::zeros(s2, s2), DMatrix::zeros(s2, s2));
-        for step in record {
-            match *step {
-                Step::Piece { state, whole, tau } => {
-                    let state = &mut self.states[state];
-                    state.advance(whole, &mut phi, &mut tmp);
-                    if tau > 0.0 {
-                        state.exp_short(tau, &mut e_tau, &mut self.work);
-                        product(&e_tau, &phi, &mut tmp);
-                        std::mem::swap(&mut phi, &mut tmp);
-                    }
-                }
-                Step::Jump { element, factor } => {
-                    let mw = self.mw[element].as_slice();
-                    saltation(self.sys, element, factor, mw, phi.as_mut_slice());
+/// An element's weights `w̃_e` (sparse) and `M⁻¹ w_e`.
+type Element = (Vec<(usize, f64)>, Vec<f64>);
+
+/// The monodromy side of the exponential flow: the generators' [`Propagator`]s and the
+/// product of a record's factors, step by step.
+pub(crate) struct Assembler {
+    propagators: Vec<Propagator>,
+    /// `(w̃_e, M⁻¹ w_e)` per element (the saltation matrices).
+    elements: Vec<Element>,
+    work: ExpWork,
+    phi: DMatrix<f64>,
+    tmp: DMatrix<f64>,
+    e_tau: DMatrix<f64>,
+}
+
+impl Assembler {
+    /// For the `2n × 2n` monodromy matrix of a flow whose elements have the weights `weights`
+    /// and `M⁻¹ w_e` = `mw`.
+    pub(crate) fn new(s2: usize, weights: &[Vec<(usize, f64)>], mw: &[DVector<f64>]) -> Self {
+        let elements = weights
+            .iter()
+            .zip(mw)
+            .map(|(w, m)| (w.clone(), m.as_slice().to_vec()))
+            .collect();
+        Self {
+            propagators: Vec::new(),
+            elements,
+            work: ExpWork::new(s2),
+            phi: DMatrix::identity(s2, s2),
+            tmp: DMatrix::zeros(s2, s2),
+            e_tau: DMatrix::zeros(s2, s2),
+        }
+    }
+
+    /// Generators known so far.
+    pub(crate) fn generators(&self) -> usize {
+        self.propagators.len()
+    }
+
+    /// The next generator (the flow's states in their order).
+    pub(crate) fn add(&mut self, core: Arc<Core>) {
+        self.propagators.push(Propagator::new(core));
+    }
+
+    /// `Φ̃ = I`: a new pass.
+    pub(crate) fn begin(&mut self) {
+        self.phi.fill_with_identity();
+    }
+
+    /// `Φ̃ ← F Φ̃` for the factor `F` of `step`.
+    pub(crate) fn apply(&mut self, step: &Step) {
+        match *step {
+            Step::Piece { state, whole, tau } => {
+                let p = &mut self.propagators[state];
+                p.advance(whole, &mut self.phi, &mut self.tmp);
+                if tau > 0.0 {
+                    p.exp_short(tau, &mut self.e_tau, &mut self.work);
+                    product(&self.e_tau, &self.phi, &mut self.tmp);
+                    std::mem::swap(&mut self.phi, &mut self.tmp);
                 }
             }
+            Step::Jump { element, factor } => {
+                let (w, mw) = &self.elements[element];
+                saltation(w, factor, mw, self.phi.as_mut_slice());
+            }
         }
-        if phi.iter().any(|v| !v.is_finite()) {
+    }
+
+    /// `Φ̃` of the pass.
+    pub(crate) fn finish(&self) -> Result<DMatrix<f64>> {
+        if self.phi.iter().any(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 what: "monodromy matrix (exponential flow)".into(),
             });
         }
-        Ok(phi)
+        Ok(self.phi.clone())
+    }
+}
+
+impl ExpFlow<'_, '_> {
+    /// The scaled monodromy matrix `Φ̃` of the pass that wrote `record`.
+    pub(crate) fn monodromy(&mut self, record: &[Step]) -> Result<DMatrix<f64>> {
+        let assembler = &mut self.assembler;
+        for state in &self.states[assembler.generators()..] {
+            assembler.add(state.core.clone());
+        }
+        assembler.begin();
+        for step in record {
+            assembler.apply(step);
+        }
+        assembler.finish()
     }
 }
