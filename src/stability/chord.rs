@@ -114,7 +114,19 @@ impl Factored {
 /// Iterates `x0` (`(q, q̇)` in the coordinates) to the periodic orbit with the flow `flow`
 /// (replaced by `runge_kutta()` where the exponential flow meets a law that is not affine),
 /// starting the chord steps with `jacobian` if given.
+/// The monodromy matrices of the exponential flow are multiplied on a second thread where
+/// there is one ([`pipeline`](super::pipeline)).
 pub(crate) fn iterate<'c, 'm>(
+    problem: &Problem,
+    flow: &mut Integration<'c, 'm>,
+    runge_kutta: &dyn Fn() -> Result<Integration<'c, 'm>>,
+    x0: &mut [f64],
+    jacobian: Option<DMatrix<f64>>,
+) -> Result<Outcome> {
+    flow.with_assembler(|flow| iterate_with(problem, flow, runge_kutta, x0, jacobian))
+}
+
+fn iterate_with<'c, 'm>(
     problem: &Problem,
     flow: &mut Integration<'c, 'm>,
     runge_kutta: &dyn Fn() -> Result<Integration<'c, 'm>>,

@@ -37,6 +37,7 @@ use super::expm::ExpWork;
 use super::generator::{Expansion, Forcing, State};
 use super::kernels::gemv;
 use super::pieces::Pieces;
+use super::pipeline::{Link, Message};
 use super::record::{Assembler, Step};
 use super::system::Coordinates;
 use crate::error::{Error, Result};
@@ -70,8 +71,9 @@ pub(crate) struct ExpFlow<'c, 'm> {
     taylor: Expansion,
     /// Integration steps (sub-steps and remainders) over all periods.
     pub(crate) steps: usize,
-    /// The monodromy side.
-    pub(super) assembler: Assembler,
+    /// The monodromy side, here or (linked) on another thread.
+    pub(super) assembler: Box<Assembler>,
+    pub(super) link: Option<Link>,
 }
 
 /// A piece: its generator and the laws' coefficients `(f0_e, k_e, d_e)`.
@@ -122,7 +124,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         let fastest = omega_max.max(omega).max(forcing.top());
         let delta0 = f64::powi(2.0, -(fastest.log2().ceil() as i32));
         let turns = forcing.turns(delta0);
-        let assembler = Assembler::new(2 * n, &sys.weights, &mw);
+        let assembler = Box::new(Assembler::new(2 * n, &sys.weights, &mw));
         Ok(Self {
             sys,
             n,
@@ -143,6 +145,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             taylor: Expansion::default(),
             steps: 0,
             assembler,
+            link: None,
         })
     }
 
@@ -176,6 +179,9 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                     }
                 }
                 let s = State::new(a, offset, &self.forcing, self.delta0, &mut self.work);
+                if let Some(link) = &self.link {
+                    link.send(Message::Generator(s.core.clone()));
+                }
                 self.states.push(s);
                 self.index.insert(key, self.states.len() - 1);
                 self.states.len() - 1
@@ -294,18 +300,21 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 };
                 self.steps += done + 1;
                 // For the monodromy matrix: Φ̃ ← e^{Ãτ} E_δ₀^done Φ̃.
-                record.push(Step::Piece {
-                    state: piece.state,
-                    whole: done,
-                    tau,
-                });
+                self.emit(
+                    record,
+                    Step::Piece {
+                        state: piece.state,
+                        whole: done,
+                        tau,
+                    },
+                );
                 let end = if crossed.is_some() { t_sub + tau } else { tb };
                 if !self.still_affine(&piece, &x, angle(end)) {
                     return Ok(false);
                 }
                 if let Some((e, up)) = crossed {
                     if let Some(factor) = self.cross(e, up, angle(end), &x) {
-                        record.push(Step::Jump { element: e, factor });
+                        self.emit(record, Step::Jump { element: e, factor });
                     }
                 }
                 t = end;

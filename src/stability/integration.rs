@@ -78,11 +78,13 @@ impl<'c, 'm> Integration<'c, 'm> {
             }
             Integration::Exponential { flow, record } => {
                 record.clear();
+                flow.begin_pass();
                 for _ in 0..periods {
                     if !flow.orbit(x, record)? {
                         return Ok(false);
                     }
                 }
+                flow.end_pass();
                 Ok(true)
             }
         }

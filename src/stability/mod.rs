@@ -77,6 +77,7 @@ mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
 mod pieces;
+mod pipeline;
 mod propagator;
 mod record;
 mod reduction;

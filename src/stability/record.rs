@@ -18,6 +18,7 @@ use super::exponential::ExpFlow;
 use super::generator::Core;
 use super::kernels::product;
 use super::pieces::saltation;
+use super::pipeline::{Link, Message};
 use super::propagator::Propagator;
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
@@ -117,8 +118,34 @@ impl Assembler {
 }
 
 impl ExpFlow<'_, '_> {
-    /// The scaled monodromy matrix `Φ̃` of the pass that wrote `record`.
+    /// Appends `step` to `record` (and sends it to a linked assembler).
+    pub(super) fn emit(&self, record: &mut Vec<Step>, step: Step) {
+        if let Some(link) = &self.link {
+            link.send(Message::Step(step));
+        }
+        record.push(step);
+    }
+
+    /// A pass begins.
+    pub(crate) fn begin_pass(&mut self) {
+        if let Some(link) = &mut self.link {
+            link.begin();
+        }
+    }
+
+    /// The pass has ended.
+    pub(crate) fn end_pass(&mut self) {
+        if let Some(link) = &self.link {
+            link.send(Message::End);
+        }
+    }
+
+    /// The scaled monodromy matrix `Φ̃` of the pass that wrote `record`: from the linked
+    /// assembler, or by replaying the record.
     pub(crate) fn monodromy(&mut self, record: &[Step]) -> Result<DMatrix<f64>> {
+        if let Some(link) = &self.link {
+            return link.monodromy();
+        }
         let assembler = &mut self.assembler;
         for state in &self.states[assembler.generators()..] {
             assembler.add(state.core.clone());
@@ -128,5 +155,29 @@ impl ExpFlow<'_, '_> {
             assembler.apply(step);
         }
         assembler.finish()
+    }
+
+    /// The assembler with every generator so far, for another thread (a placeholder stays).
+    pub(crate) fn take_assembler(&mut self) -> Box<Assembler> {
+        let placeholder = Box::new(Assembler::new(0, &[], &[]));
+        let mut assembler = std::mem::replace(&mut self.assembler, placeholder);
+        for state in &self.states[assembler.generators()..] {
+            assembler.add(state.core.clone());
+        }
+        assembler
+    }
+
+    /// The assembler back from its thread.
+    pub(crate) fn restore_assembler(&mut self, assembler: Box<Assembler>) {
+        self.assembler = assembler;
+    }
+
+    /// Sends the generators and steps from now on to the assembler at the other end of `link`.
+    pub(crate) fn link(&mut self, link: Link) {
+        self.link = Some(link);
+    }
+
+    pub(crate) fn unlink(&mut self) -> Option<Link> {
+        self.link.take()
     }
 }
