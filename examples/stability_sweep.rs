@@ -7,9 +7,11 @@
 //!
 //! Defaults: `examples/scenes/large/drivetrain_1000.toml` from 1000 to 3000 in the scene's
 //! speed unit, the continuation's default largest step (1.0; 0.0075 gives about 500 points),
-//! one run of each. Times are wall clock and this thread's CPU time (`/proc/thread-self`, on
-//! Linux; the machine may be shared), the medians over the repeats. No error estimate per
-//! point (the HB side of `hbal sweep --no-error-estimate`).
+//! one run of each. Times are wall clock, this thread's CPU time (`/proc/thread-self`, on
+//! Linux; the machine may be shared) and the CPU time of every thread of the process (the
+//! monodromy matrices may be multiplied on a second thread), the medians over the repeats. No error estimate per
+//! point (the HB side of `hbal sweep --no-error-estimate`). With `DUMP` set in the environment,
+//! every point's Ω, steps, orbit correction, `polished` and multipliers go to stderr.
 
 use hbal::continuation::{Branch, Continuation};
 use hbal::scene::Scene;
@@ -33,6 +35,20 @@ fn cpu_ms(start: Instant) -> f64 {
         .map_or_else(|| start.elapsed().as_secs_f64() * 1e3, |ns| ns * 1e-6)
 }
 
+/// CPU time of the whole process (every thread, also those that have ended) in ms, from
+/// `/proc/self/stat` (ticks of 10 ms); 0 where it is not there.
+fn process_cpu_ms() -> f64 {
+    std::fs::read_to_string("/proc/self/stat")
+        .ok()
+        .and_then(|s| {
+            // After the command name in parentheses: state is field 3, utime 14, stime 15.
+            let rest = &s[s.rfind(')')? + 2..];
+            let f: Vec<&str> = rest.split_whitespace().collect();
+            Some((f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?) * 10.0)
+        })
+        .unwrap_or(0.0)
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -51,8 +67,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let to = flag(&args, "--to", 3000.0) * unit;
     let repeat = flag(&args, "--repeat", 1.0).max(1.0) as usize;
     let basis = scene.basis.with_omega(from)?;
-    let run = |stability: Option<FloquetOptions>| -> Result<(f64, f64, Branch), hbal::Error> {
-        let (mut walls, mut cpus, mut last) = (Vec::new(), Vec::new(), None);
+    let run = |stability: Option<FloquetOptions>| -> Result<(f64, f64, f64, Branch), hbal::Error> {
+        let (mut walls, mut cpus, mut all, mut last) = (Vec::new(), Vec::new(), Vec::new(), None);
         for _ in 0..repeat {
             let c = Continuation {
                 max_step: flag(&args, "--max-step", 1.0),
@@ -61,16 +77,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..Continuation::default()
             };
             let start = Instant::now();
-            let cpu = cpu_ms(start);
+            let (cpu, process) = (cpu_ms(start), process_cpu_ms());
             let branch = c.run(&scene.model, basis, to, |_| {})?;
             cpus.push(cpu_ms(start) - cpu);
+            all.push(process_cpu_ms() - process);
             walls.push(start.elapsed().as_secs_f64() * 1e3);
             last = Some(branch);
         }
-        Ok((median(walls), median(cpus), last.expect("one run")))
+        Ok((
+            median(walls),
+            median(cpus),
+            median(all),
+            last.expect("one run"),
+        ))
     };
-    let (wall_hb, cpu_hb, plain) = run(None)?;
-    let (wall, cpu, branch) = run(Some(FloquetOptions::default()))?;
+    let (wall_hb, cpu_hb, all_hb, plain) = run(None)?;
+    let (wall, cpu, all, branch) = run(Some(FloquetOptions::default()))?;
     let points = branch.points.len();
     if std::env::var("DUMP").is_ok() {
         dump(&branch);
@@ -105,21 +127,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         to,
         flag(&args, "--max-step", 1.0)
     );
-    println!("| | wall ms | CPU ms | per point (CPU) ms |");
-    println!("|---|---:|---:|---:|");
     println!(
-        "| continuation without stability | {wall_hb:.0} | {cpu_hb:.0} | {:.1} |",
-        cpu_hb / plain.points.len() as f64
+        "| | wall ms | CPU ms | per point (CPU) ms | per point (wall) ms | all threads' CPU ms |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|");
+    println!(
+        "| continuation without stability | {wall_hb:.0} | {cpu_hb:.0} | {:.1} | {:.1} | {all_hb:.0} |",
+        cpu_hb / plain.points.len() as f64,
+        wall_hb / plain.points.len() as f64
     );
     println!(
-        "| continuation with stability | {wall:.0} | {cpu:.0} | {:.1} |",
-        cpu / points as f64
+        "| continuation with stability | {wall:.0} | {cpu:.0} | {:.1} | {:.1} | {all:.0} |",
+        cpu / points as f64,
+        wall / points as f64
     );
     println!(
-        "| stability share (difference) | {:.0} | {:.0} | {:.1} |",
+        "| stability share (difference) | {:.0} | {:.0} | {:.1} | {:.1} | {:.0} |",
         wall - wall_hb,
         cpu - cpu_hb,
-        (cpu - cpu_hb) / points as f64
+        (cpu - cpu_hb) / points as f64,
+        (wall - wall_hb) / points as f64,
+        all - all_hb
     );
     let mean = steps.iter().sum::<usize>() as f64 / steps.len().max(1) as f64;
     println!(
@@ -147,9 +175,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 fn dump(branch: &Branch) {
     for p in &branch.points {
         if let Some(f) = &p.floquet {
+            let mu: Vec<String> = f
+                .multipliers
+                .iter()
+                .map(|m| format!("{:.15e},{:.15e}", m.re, m.im))
+                .collect();
             eprintln!(
-                "{:.2} steps {} corr {:.2e}",
-                p.omega, f.steps, f.orbit_correction
+                "{:.6} steps {} corr {:.2e} polished {} mu {}",
+                p.omega,
+                f.steps,
+                f.orbit_correction,
+                f.polished,
+                mu.join(" ")
             );
         }
     }

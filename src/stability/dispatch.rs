@@ -3,6 +3,7 @@
 //! modes below a cut-off plus attachment modes, `2(r + a) × 2(r + a)` whatever n), and the
 //! reduction's accuracy estimate.
 
+use super::chord::KeptJacobian;
 use super::reduction::{reduced_basis, ModeCache};
 use super::shooting::{distance, shoot, Goal, Shot, Start};
 use super::system::Coordinates;
@@ -132,29 +133,42 @@ impl FloquetOptions {
             }
         };
         let omega = solution.basis().omega();
-        // Start from the previous point's correction if it is near; from the HB state if
-        // that fails to converge.
+        // Start from the previous point's correction (extrapolated along the last two points)
+        // if it is near; from the HB state if that fails to converge. The chord steps start
+        // with the previous point's monodromy matrix.
         let mut shot = None;
-        if let Some((w, d)) = &cache.correction {
-            if (omega - w).abs() <= 0.2 * w && d.len() == 2 * n {
-                let s = shoot(&sys, solution, self, Start::Corrected(d), Goal::Exact)?;
-                if s.floquet.polished {
-                    shot = Some(s);
-                }
+        let jacobian = cache.jacobian.as_ref();
+        if let Some(d) = cache.predicted_correction(omega, 2 * n) {
+            let s = shoot(
+                &sys,
+                solution,
+                self,
+                Start::Corrected(&d),
+                Goal::Exact,
+                jacobian,
+            )?;
+            if s.floquet.polished {
+                shot = Some(s);
             }
         }
-        let Shot { mut floquet, kappa } = match shot {
+        let shot = match shot {
             Some(s) => s,
-            None => shoot(&sys, solution, self, Start::Hb, Goal::Exact)?,
+            None => shoot(&sys, solution, self, Start::Hb, Goal::Exact, jacobian)?,
         };
+        let Shot {
+            mut floquet, kappa, ..
+        } = shot;
         cache.kappa = kappa.or(cache.kappa);
-        cache.correction = floquet.polished.then(|| {
+        cache.jacobian = Some(shot.jacobian);
+        let correction = floquet.polished.then(|| {
             let x_hb = (0..n)
                 .map(|i| solution.displacement(i, 0.0))
                 .chain((0..n).map(|i| solution.velocity(i, 0.0)));
-            let d = floquet.orbit_start.iter().zip(x_hb).map(|(a, b)| a - b);
+            let start = shot.ahead.as_ref().unwrap_or(&floquet.orbit_start);
+            let d = start.iter().zip(x_hb).map(|(a, b)| a - b);
             (omega, d.collect())
         });
+        cache.previous = std::mem::replace(&mut cache.correction, correction);
         if let Some(mut info) = reduction {
             if info.dofs >= n {
                 info.estimate = Some(0.0);
@@ -228,7 +242,7 @@ impl FloquetOptions {
         };
         let sys = Coordinates::reduced(model, larger.v);
         let start = Start::State(&floquet.orbit_start);
-        let reference = shoot(&sys, solution, self, start, goal)?.floquet;
+        let reference = shoot(&sys, solution, self, start, goal, None)?.floquet;
         info.estimate = Some(distance(&floquet.multipliers, &reference.multipliers));
         floquet.steps += reference.steps;
         Ok(())
@@ -236,12 +250,43 @@ impl FloquetOptions {
 }
 
 /// What a sweep's Floquet analyses keep from one point to the next
-/// ([`FloquetOptions::compute_with`]): the undamped modes of the model, the last orbit
-/// correction (the shooting of the next point starts from the HB state plus it), and the
-/// sensitivity of the multipliers to the orbit measured by the last shooting.
+/// ([`FloquetOptions::compute_with`]): the undamped modes of the model, the last two orbit
+/// corrections (the shooting of the next point starts from the HB state plus their linear
+/// extrapolation in Ω), the last monodromy matrix (the first Jacobian of the next shooting's
+/// chord steps) and the sensitivity of the multipliers to the orbit measured by the last
+/// shooting that measured it.
 #[derive(Debug, Clone, Default)]
 pub struct FloquetCache {
     modes: ModeCache,
     correction: Option<(f64, Vec<f64>)>,
+    previous: Option<(f64, Vec<f64>)>,
+    jacobian: Option<KeptJacobian>,
     kappa: Option<f64>,
+}
+
+impl FloquetCache {
+    /// The orbit correction `(δq, δq̇)` (`len` values) predicted at `omega` from the last one
+    /// `d₁` at `Ω₁` if it is within 20 %: `d₁ + (d₁ - d₀) (Ω - Ω₁)/(Ω₁ - Ω₀)` with the one
+    /// before, `d₀` at `Ω₀`, where the sweep goes on in the same direction by at most twice
+    /// the last step (not across a turn of the branch), `d₁` otherwise.
+    fn predicted_correction(&self, omega: f64, len: usize) -> Option<Vec<f64>> {
+        let (w1, d1) = self.correction.as_ref()?;
+        if (omega - w1).abs() > 0.2 * w1 || d1.len() != len {
+            return None;
+        }
+        let ratio = match &self.previous {
+            Some((w0, d0)) if d0.len() == len && w1 != w0 => (omega - w1) / (w1 - w0),
+            _ => 0.0,
+        };
+        if !(ratio > 0.0 && ratio <= 2.0) {
+            return Some(d1.clone());
+        }
+        let d0 = &self.previous.as_ref()?.1;
+        Some(
+            d1.iter()
+                .zip(d0)
+                .map(|(a, b)| a + (a - b) * ratio)
+                .collect(),
+        )
+    }
 }

@@ -22,9 +22,10 @@
 //!   `x̃(t+τ) = Σ τⁱ x̃⁽ⁱ⁾/i!`, `x̃⁽ⁱ⁺¹⁾ = Ã x̃⁽ⁱ⁾ + b̃⁽ⁱ⁾(t)`;
 //! * a kink crossing is detected on every sub-step from the cubic Hermite interpolant of `u` as
 //!   in the Runge–Kutta flow and located by Newton on the same Taylor series;
-//! * the monodromy matrix: one product per set bit of `m`, and `e^{Ãτ}` for the last part
-//!   (`τ = r`, or up to the crossing) by the Taylor polynomial, a linear combination of the kept
-//!   `Ãⁱ/i!`; at a crossing the saltation matrix of a force jump.
+//! * the monodromy matrix, afterwards and only for the orbits that need it, from the record of
+//!   the pass ([`record`](super::record)): one product per set bit of `m`, and `e^{Ãτ}` for the
+//!   last part (`τ = r`, or up to the crossing) by the Taylor polynomial, a linear combination
+//!   of the kept `Ãⁱ/i!`; at a crossing the saltation matrix of a force jump.
 //!
 //! The laws' coefficients are read at a fixed point inside each kink interval
 //! ([`Pieces::inside`]), so that equal pieces give bit-equal keys. At the end of every piece
@@ -34,7 +35,10 @@
 
 use super::expm::ExpWork;
 use super::generator::{Expansion, Forcing, State};
+use super::kernels::gemv;
 use super::pieces::Pieces;
+use super::pipeline::{Link, Message};
+use super::record::{Assembler, Step};
 use super::system::Coordinates;
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
@@ -61,12 +65,15 @@ pub(crate) struct ExpFlow<'c, 'm> {
     turns: Vec<(f64, f64)>,
     work: ExpWork,
     /// The generators met so far, and their index by the laws' coefficients.
-    states: Vec<State>,
+    pub(super) states: Vec<State>,
     index: HashMap<Vec<u64>, usize>,
     /// The Taylor series of the exact solution from the last expansion point.
     taylor: Expansion,
     /// Integration steps (sub-steps and remainders) over all periods.
     pub(crate) steps: usize,
+    /// The monodromy side, here or (linked) on another thread.
+    pub(super) assembler: Box<Assembler>,
+    pub(super) link: Option<Link>,
 }
 
 /// A piece: its generator and the laws' coefficients `(f0_e, k_e, d_e)`.
@@ -104,7 +111,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             .copy_from(&(-(&m_inv * &sys.stiffness) / omega_s));
         base.view_mut((n, n), (n, n))
             .copy_from(&(-(&m_inv * &sys.damping)));
-        let mw = sys
+        let mw: Vec<DVector<f64>> = sys
             .weights
             .iter()
             .map(|w| {
@@ -117,6 +124,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         let fastest = omega_max.max(omega).max(forcing.top());
         let delta0 = f64::powi(2.0, -(fastest.log2().ceil() as i32));
         let turns = forcing.turns(delta0);
+        let assembler = Box::new(Assembler::new(2 * n, &sys.weights, &mw));
         Ok(Self {
             sys,
             n,
@@ -136,6 +144,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             index: HashMap::new(),
             taylor: Expansion::default(),
             steps: 0,
+            assembler,
+            link: None,
         })
     }
 
@@ -169,6 +179,9 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                     }
                 }
                 let s = State::new(a, offset, &self.forcing, self.delta0, &mut self.work);
+                if let Some(link) = &self.link {
+                    link.send(Message::Generator(s.core.clone()));
+                }
                 self.states.push(s);
                 self.index.insert(key, self.states.len() - 1);
                 self.states.len() - 1
@@ -210,16 +223,15 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             })
     }
 
-    /// Integrates `y = (q, q̇, Φ̃)` over one period `[0, T]`. `Ok(false)`: a law is not affine
-    /// on its piece (`y` is then meaningless; use the Runge–Kutta flow).
-    pub(crate) fn period(&mut self, y: &mut [f64]) -> Result<bool> {
+    /// Integrates the state `y = (q, q̇)` over one period `[0, T]` and appends its pieces to
+    /// `record` (what [`ExpFlow::monodromy`] multiplies). `Ok(false)`: a law is not affine on
+    /// its piece (`y` is then meaningless; use the Runge–Kutta flow).
+    pub(crate) fn orbit(&mut self, y: &mut [f64], record: &mut Vec<Step>) -> Result<bool> {
         let n = self.n;
         let s2 = 2 * n;
         let mut x = DVector::from_fn(s2, |i, _| {
             y[i] / if i < n { self.scale_q } else { self.scale_v }
         });
-        let mut phi = DMatrix::from_column_slice(s2, s2, &y[s2..]);
-        let (mut e_tau, mut tmp) = (DMatrix::zeros(s2, s2), DMatrix::zeros(s2, s2));
         let mut z = DVector::zeros(self.forcing.states());
         let mut x_new = DVector::zeros(s2);
         let elements = self.mw.len();
@@ -251,8 +263,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 self.kink_states(&x, &mut at_start);
                 self.forcing.oscillator(t, &mut z);
                 for _ in 0..whole as usize {
-                    x_new.gemv(1.0, state.e0(), &x, 0.0);
-                    x_new.gemv(1.0, &state.x0, &z, 1.0);
+                    gemv(state.e0(), x.as_slice(), x_new.as_mut_slice(), false);
+                    gemv(&state.x0, z.as_slice(), x_new.as_mut_slice(), true);
                     self.kink_states(&x_new, &mut at_end);
                     hit = self.first_crossing(&at_start, &at_end, delta0);
                     if hit.is_some() {
@@ -287,20 +299,23 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                     }
                 };
                 self.steps += done + 1;
-                // Φ̃ ← e^{Ãτ} E_δ₀^done Φ̃.
-                let state = &mut self.states[piece.state];
-                state.advance(done, &mut phi, &mut tmp);
-                if tau > 0.0 {
-                    state.exp_short(tau, &mut e_tau, &mut self.work);
-                    tmp.gemm(1.0, &e_tau, &phi, 0.0);
-                    std::mem::swap(&mut phi, &mut tmp);
-                }
+                // For the monodromy matrix: Φ̃ ← e^{Ãτ} E_δ₀^done Φ̃.
+                self.emit(
+                    record,
+                    Step::Piece {
+                        state: piece.state,
+                        whole: done,
+                        tau,
+                    },
+                );
                 let end = if crossed.is_some() { t_sub + tau } else { tb };
                 if !self.still_affine(&piece, &x, angle(end)) {
                     return Ok(false);
                 }
                 if let Some((e, up)) = crossed {
-                    self.cross(e, up, angle(end), &x, &mut phi);
+                    if let Some(factor) = self.cross(e, up, angle(end), &x) {
+                        self.emit(record, Step::Jump { element: e, factor });
+                    }
                 }
                 t = end;
             }
@@ -308,10 +323,9 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         for i in 0..s2 {
             y[i] = x[i] * if i < n { self.scale_q } else { self.scale_v };
         }
-        y[s2..].copy_from_slice(phi.as_slice());
-        if y.iter().any(|v| !v.is_finite()) {
+        if y[..s2].iter().any(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
-                what: "variational equation (exponential flow)".into(),
+                what: "orbit (exponential flow)".into(),
             });
         }
         Ok(true)
@@ -367,20 +381,12 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         tau
     }
 
-    /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`
-    /// ([`Pieces::cross_with_saltation`]).
-    fn cross(&mut self, e: usize, up: bool, theta: f64, x: &DVector<f64>, phi: &mut DMatrix<f64>) {
+    /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`: the
+    /// factor of the saltation matrix of its force jump ([`Pieces::cross_jump`]).
+    fn cross(&mut self, e: usize, up: bool, theta: f64, x: &DVector<f64>) -> Option<f64> {
         let (u, du) = self.element_state(e, x);
         let omega_s = self.scale_v / self.scale_q;
-        let mw = self.mw[e].as_slice();
-        self.pieces.cross_with_saltation(
-            self.sys,
-            e,
-            up,
-            (theta, u, du),
-            mw,
-            omega_s,
-            phi.as_mut_slice(),
-        );
+        self.pieces
+            .cross_jump(self.sys, e, up, (theta, u, du), omega_s)
     }
 }

@@ -1,7 +1,7 @@
 //! The pieces' generators of the exponential flow ([`exponential`](super::exponential)) and
 //! what is kept per generator: the scaled load as an oscillator ([`Forcing`]), and per
-//! distinct generator ([`State`]) the Taylor powers, the exact sub-step `(E_δ₀, X_δ₀)` and the
-//! ladder `E_δ₀^{2^j}`.
+//! distinct generator ([`State`]) the Taylor powers and the exact sub-step `(E_δ₀, X_δ₀)`; the
+//! monodromy matrix's factors per generator are the [`propagator`](super::propagator)'s.
 //!
 //! **Forcing.** With the oscillator state `z = (1, cos k₁Ωt, sin k₁Ωt, …)` over the load
 //! orders, `z' = S z`, and `C` its map to the loads summed per loaded DOF, the scaled load is
@@ -14,13 +14,12 @@
 //! (`B` the forcing matrix), cut at the first `p` with `(kΩδ)^{p+1}/(p+1)! < 1e-16`. Both are
 //! formed at `δ₀/2^f` with `‖Ã δ₀/2^f‖₁ <= 1` and doubled `f` times:
 //! `E_{2δ} = E_δ²`, `X_{2δ} = E_δ X_δ + X_δ e^{Sδ}` (two sub-steps in a row).
-//!
-//! **Ladder.** `L_j = E_δ₀^{2^j}`, squared on demand, so that `m` whole sub-steps of the
-//! monodromy matrix cost one product per set bit of `m`.
 
 use super::expm::{inverse_factorial, phi_narrow, squarings, ExpWork, Powers};
+use super::kernels::gemv;
 use super::system::Coordinates;
 use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 
 /// Highest power of `Sδ` in the forcing's series.
 const MAX_DEGREE: usize = 8;
@@ -34,6 +33,8 @@ pub(crate) struct Forcing {
     dirs: DMatrix<f64>,
     /// `C Sʲ`, `j = 0..=MAX_DEGREE`.
     channels: Vec<DMatrix<f64>>,
+    /// `G C` (n × oscillator states).
+    load: DMatrix<f64>,
     /// `S`.
     generator: DMatrix<f64>,
 }
@@ -78,11 +79,13 @@ impl Forcing {
             let next = &channels[j - 1] * &generator;
             channels.push(next);
         }
+        let load = &dirs * &channels[0];
         Self {
             omega,
             orders,
             dirs,
             channels,
+            load,
             generator,
         }
     }
@@ -144,15 +147,7 @@ impl Forcing {
     /// `out += G C w` for the oscillator vector `w` (the load's velocity rows; `w = Sⁱ z` gives
     /// its `i`-th time derivative).
     pub(crate) fn add_load(&self, w: &DVector<f64>, out: &mut [f64]) {
-        let c = &self.channels[0];
-        for d in 0..c.nrows() {
-            let v = c.row(d).dot(&w.transpose());
-            if v != 0.0 {
-                for (o, g) in out.iter_mut().zip(self.dirs.column(d).iter()) {
-                    *o += v * g;
-                }
-            }
-        }
+        gemv(&self.load, w.as_slice(), out, true);
     }
 
     /// `w ← S w` (each pair `(c, s)` of order `k` becomes `kΩ (-s, c)`, the constant 0).
@@ -167,17 +162,21 @@ impl Forcing {
     }
 }
 
-/// What is kept of one generator `Ã`.
-pub(crate) struct State {
+/// What both the orbit and its monodromy matrix need of one generator `Ã`: its powers and the
+/// exact sub-step `E_δ₀` (shared with the monodromy side, which may run on another thread).
+pub(crate) struct Core {
     pub(crate) powers: Powers,
-    /// `E_δ₀` and the ladder `L_j = E_δ₀^{2^j}` (`ladder[0] = E_δ₀`).
-    ladder: Vec<DMatrix<f64>>,
+    /// `E_δ₀`.
+    pub(crate) e0: DMatrix<f64>,
+}
+
+/// What the orbit keeps of one generator `Ã`.
+pub(crate) struct State {
+    pub(crate) core: Arc<Core>,
     /// `X_δ₀`.
     pub(crate) x0: DMatrix<f64>,
     /// The constant part of the forcing (velocity rows).
     pub(crate) offset: DVector<f64>,
-    /// `Aⁱ/i!`, `i = 0..=16`, formed at the first short exponential.
-    terms: Vec<DMatrix<f64>>,
 }
 
 impl State {
@@ -233,70 +232,20 @@ impl State {
             delta *= 2.0;
         }
         Self {
-            powers,
-            ladder: vec![e],
+            core: Arc::new(Core { powers, e0: e }),
             x0: x,
             offset,
-            terms: Vec::new(),
-        }
-    }
-
-    /// `out = e^{Aτ}`. For `‖Aτ‖₁ <= 1` (the pieces' last parts are shorter than `δ₀`) the
-    /// Taylor polynomial `Σ_{i<=d} τⁱ (Aⁱ/i!)` from the kept terms, `d` the first degree whose
-    /// next term is below 1e-16 of the norm (at most 16): a linear combination, no product;
-    /// scaling and squaring otherwise.
-    pub(crate) fn exp_short(&mut self, tau: f64, out: &mut DMatrix<f64>, work: &mut ExpWork) {
-        let x = self.powers.norm * tau.abs();
-        if x > 1.0 {
-            work.exp(&self.powers, tau, out);
-            return;
-        }
-        if self.terms.is_empty() {
-            let p = &self.powers;
-            let m = p.a.nrows();
-            self.terms = vec![
-                DMatrix::identity(m, m),
-                p.a.clone(),
-                p.a2() / 2.0,
-                p.a3() / 6.0,
-                p.a4() / 24.0,
-            ];
-            for i in 5..=16 {
-                let next = &self.terms[i - 1] * &p.a / i as f64;
-                self.terms.push(next);
-            }
-        }
-        let degree = (1..16)
-            .find(|&d| x.powi(d as i32 + 1) * inverse_factorial(d + 1) < 1e-16)
-            .unwrap_or(16);
-        out.copy_from(&self.terms[degree]);
-        for term in self.terms[..degree].iter().rev() {
-            for (o, t) in out.as_mut_slice().iter_mut().zip(term.as_slice()) {
-                *o = *o * tau + t;
-            }
         }
     }
 
     /// `E_δ₀`.
     pub(crate) fn e0(&self) -> &DMatrix<f64> {
-        &self.ladder[0]
+        &self.core.e0
     }
 
-    /// `phi ← E_δ₀^k phi` (`tmp` a buffer of its shape).
-    pub(crate) fn advance(&mut self, k: usize, phi: &mut DMatrix<f64>, tmp: &mut DMatrix<f64>) {
-        let mut j = 0;
-        while k >> j != 0 {
-            if j == self.ladder.len() {
-                let last = &self.ladder[j - 1];
-                let next = last * last;
-                self.ladder.push(next);
-            }
-            if (k >> j) & 1 == 1 {
-                tmp.gemm(1.0, &self.ladder[j], phi, 0.0);
-                std::mem::swap(phi, tmp);
-            }
-            j += 1;
-        }
+    /// `Ã`.
+    pub(crate) fn a(&self) -> &DMatrix<f64> {
+        &self.core.powers.a
     }
 }
 
@@ -337,7 +286,7 @@ impl Expansion {
             }
             let (done, next) = self.derivs.split_at_mut(i + 1);
             let next = &mut next[0];
-            next.gemv(1.0, &state.powers.a, &done[i], 0.0);
+            gemv(state.a(), done[i].as_slice(), next.as_mut_slice(), false);
             let v = &mut next.as_mut_slice()[n..];
             forcing.add_load(&z, v);
             forcing.differentiate(&mut z);

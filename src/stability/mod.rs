@@ -64,17 +64,24 @@
 //! ```
 
 mod affine;
+mod chord;
 mod dispatch;
 mod dopri;
 mod expm;
 mod exponential;
 mod flow;
 mod generator;
+mod integration;
+mod kernels;
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
 mod pieces;
+mod pipeline;
+mod propagator;
+mod record;
 mod reduction;
+mod scales;
 mod shooting;
 mod system;
 

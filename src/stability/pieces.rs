@@ -81,36 +81,45 @@ impl Pieces {
     }
 
     /// Moves element `e` across its kink at `(θ, u, u̇)` and applies the saltation matrix of a
-    /// force jump `Δf` there to the scaled monodromy matrix `phi` (column-major, `2n × 2n`, `mw`
-    /// = `M⁻¹ w_e`, `omega_s = s_v/s_q`): with `g = w·q - kink` and `F = (q̇, M⁻¹(…))`,
-    /// `S = I + (F⁺ - F⁻) ∇gᵀ / (∇g·F⁻)` adds `-M⁻¹ w Δf (wᵀ δq) / u̇` to `δq̇`, scaled
-    /// `δṽ += -M⁻¹ w Δf (wᵀ δq̃) / (u̇ ω_s)`. Nothing where the force is continuous.
+    /// force jump there to the scaled monodromy matrix `phi` ([`Pieces::cross_jump`],
+    /// [`saltation`]; column-major, `2n × 2n`, `mw` = `M⁻¹ w_e`, `omega_s = s_v/s_q`).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn cross_with_saltation(
         &mut self,
         sys: &Coordinates,
         e: usize,
         up: bool,
-        (theta, u, du): (f64, f64, f64),
+        at: (f64, f64, f64),
         mw: &[f64],
         omega_s: f64,
         phi: &mut [f64],
     ) {
+        if let Some(factor) = self.cross_jump(sys, e, up, at, omega_s) {
+            saltation(&sys.weights[e], factor, mw, phi);
+        }
+    }
+
+    /// Moves element `e` across its kink at `(θ, u, u̇)` and returns the factor
+    /// `c = -Δf / (u̇ ω_s)` of the saltation matrix of the force jump `Δf` there: with
+    /// `g = w·q - kink` and `F = (q̇, M⁻¹(…))`, `S = I + (F⁺ - F⁻) ∇gᵀ / (∇g·F⁻)` adds
+    /// `-M⁻¹ w Δf (wᵀ δq) / u̇` to `δq̇`, scaled `δṽ += c M⁻¹ w (wᵀ δq̃)` (`ω_s = s_v/s_q`).
+    /// `None` where the force is continuous.
+    pub(crate) fn cross_jump(
+        &mut self,
+        sys: &Coordinates,
+        e: usize,
+        up: bool,
+        (theta, u, du): (f64, f64, f64),
+        omega_s: f64,
+    ) -> Option<f64> {
         let (before, _, _) = self.law(sys, e, theta, u, du);
         self.cross(e, up);
         let (after, _, _) = self.law(sys, e, theta, u, du);
         let jump = after - before;
         if jump.abs() <= 1e-9 * before.abs().max(after.abs()) || du == 0.0 {
-            return;
+            return None;
         }
-        let factor = -jump / (du * omega_s);
-        let n = mw.len();
-        for col in phi.chunks_exact_mut(2 * n) {
-            let wq = sys.gather(e, &col[..n]);
-            for (c, m) in col[n..].iter_mut().zip(mw) {
-                *c += factor * m * wq;
-            }
-        }
+        Some(-jump / (du * omega_s))
     }
 
     /// Force and derivatives `(f, ∂f/∂u, ∂f/∂u̇)` of element `e` on its current piece at
@@ -212,6 +221,19 @@ impl Pieces {
             prev_s = s;
         }
         None
+    }
+}
+
+/// `Φ̃ ← S Φ̃` for the saltation matrix of a force jump of an element with weights `w̃_e`
+/// (`weights`) and factor `c` ([`Pieces::cross_jump`]): every column gets
+/// `δṽ += c M⁻¹ w_e (w̃_e·δq̃)` (`mw` = `M⁻¹ w_e`, `phi` column-major with `2n` rows).
+pub(crate) fn saltation(weights: &[(usize, f64)], factor: f64, mw: &[f64], phi: &mut [f64]) {
+    let n = mw.len();
+    for col in phi.chunks_exact_mut(2 * n) {
+        let wq: f64 = weights.iter().map(|&(i, w)| col[i] * w).sum();
+        for (c, m) in col[n..].iter_mut().zip(mw) {
+            *c += factor * m * wq;
+        }
     }
 }
 

@@ -1,15 +1,18 @@
-//! Newton shooting and the monodromy matrix in given coordinates (the model's DOFs or a reduced
-//! basis, [`Coordinates`]): `x₀ ← x₀ - (Φ - I)⁻¹ (φ_T(x₀) - x₀)` from the HB state at `t = 0`
-//! (projected onto the coordinates), then the multipliers of `Φ` without its neutral block.
+//! Shooting and the monodromy matrix in given coordinates (the model's DOFs or a reduced basis,
+//! [`Coordinates`]): `x₀ ← x₀ - (J - I)⁻¹ (φ_T(x₀) - x₀)` from the HB state at `t = 0`
+//! (projected onto the coordinates) with Newton–chord steps ([`chord`](super::chord)), then
+//! the multipliers of the final orbit's `Φ` without its neutral block.
 
-use super::dopri::Stepper;
+use super::chord::{iterate, KeptJacobian, Problem};
 use super::exponential::ExpFlow;
 use super::flow::{Flow, FlowOptions};
+use super::integration::Integration;
+use super::scales::scales;
 use super::system::Coordinates;
 use super::{affine, eigenvalues, neutral, Floquet, FloquetOptions, Integrator};
 use crate::error::{Error, Result};
 use crate::solution::Solution;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use num_complex::Complex64;
 
 /// Where the shooting starts.
@@ -44,6 +47,11 @@ pub(crate) enum Goal<'a> {
 pub(crate) struct Shot {
     pub(crate) floquet: Floquet,
     pub(crate) kappa: Option<f64>,
+    /// Converged: the next point's best guess of the orbit's start in the model's DOFs
+    /// ([`Outcome::ahead`](super::chord::Outcome::ahead)).
+    pub(crate) ahead: Option<Vec<f64>>,
+    /// The scaled monodromy matrix of the final orbit, for the chord steps of the next point.
+    pub(crate) jacobian: KeptJacobian,
 }
 
 /// The Floquet analysis of `solution` in the coordinates `sys`.
@@ -53,6 +61,7 @@ pub(crate) fn shoot(
     options: &FloquetOptions,
     start: Start,
     goal: Goal,
+    jacobian: Option<&KeptJacobian>,
 ) -> Result<Shot> {
     let n_model = sys.model.n_dofs();
     let n = sys.len();
@@ -74,20 +83,18 @@ pub(crate) fn shoot(
     let (scale_q, omega_max, amplitudes) = scales(sys, solution, &harmonics);
     let scale_v = scale_q * omega_max;
     let runge_kutta = || -> Result<Integration> {
-        Ok(Integration::RungeKutta {
-            flow: Flow::new(sys, omega, scale_q, scale_v, options.rtol)?,
-            stepper: Stepper::new(2 * sys.len() * (1 + 2 * sys.len())),
-            opts: FlowOptions {
-                rtol: options.rtol,
-                h_max: 1.0 / omega_max,
-                max_steps: options.max_steps,
-            },
-        })
+        let opts = FlowOptions {
+            rtol: options.rtol,
+            h_max: 1.0 / omega_max,
+            max_steps: options.max_steps,
+        };
+        let flow = Flow::new(sys, omega, scale_q, scale_v, options.rtol)?;
+        Ok(Integration::runge_kutta(flow, opts, 2 * n))
     };
     let mut flow = if options.integrator == Integrator::Auto
         && affine::piecewise_affine(sys.model, &amplitudes)
     {
-        Integration::Exponential(ExpFlow::new(
+        Integration::exponential(ExpFlow::new(
             sys,
             omega,
             scale_q,
@@ -98,9 +105,7 @@ pub(crate) fn shoot(
     } else {
         runge_kutta()?
     };
-    let mut earlier_steps = 0;
     let s2 = 2 * n;
-    let scale = |i: usize| if i < n { scale_q } else { scale_v };
     // The HB state at t = 0 in the model's DOFs and in these coordinates.
     let x_hb: Vec<f64> = (0..n_model)
         .map(|i| solution.displacement(i, 0.0))
@@ -128,77 +133,25 @@ pub(crate) fn shoot(
         None => eigenvalues(phi),
         Some(w) => eigenvalues(&(w.transpose() * phi * w)),
     };
-    let mut first: Option<(Vec<Complex64>, f64)> = None;
-    let mut kappa = None;
-    let mut y = vec![0.0; s2 * (1 + s2)];
-    let mut phi = DMatrix::<f64>::zeros(s2, s2);
-    let mut polished = false;
-    let mut last_residual = f64::INFINITY;
-    let mut iteration = 0;
-    loop {
-        y[..s2].copy_from_slice(&x0);
-        y[s2..].fill(0.0);
-        for i in 0..s2 {
-            y[s2 + i * s2 + i] = 1.0;
-        }
-        // A period-multiplied orbit: ν excitation periods (the system is T-periodic).
-        let mut affine = true;
-        for _ in 0..solution.basis().subharmonic() {
-            affine = affine && flow.period(&mut y)?;
-        }
-        if !affine {
-            // A law bent inside a piece: the Runge–Kutta flow from the same start.
-            earlier_steps += flow.steps();
-            flow = runge_kutta()?;
-            continue;
-        }
-        phi.copy_from_slice(&y[s2..]);
-        if phi.iter().any(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "monodromy matrix".into(),
-            });
-        }
-        // Scaled shooting residual r̃ = S⁻¹ (φ_T(x₀) - x₀).
-        let r = DVector::from_fn(s2, |i, _| (y[i] - x0[i]) / scale(i));
-        let res = r.amax();
-        if let (1, Some((mu, step))) = (iteration, &first) {
-            kappa = Some(distance(mu, &multipliers_of(&phi)) / step);
-        }
-        // Converged to the integration noise, or Newton has stalled there.
-        if res <= 10.0 * options.rtol {
-            polished = true;
-            break;
-        }
-        if iteration >= options.max_shooting || !res.is_finite() || res >= 0.5 * last_residual {
-            polished = res <= 1e3 * options.rtol;
-            break;
-        }
-        last_residual = res;
-        iteration += 1;
-        // (Φ̃ - I) δ̃ = -r̃ with δ̃ orthogonal to rigid-body positions.
-        let a = (&phi - DMatrix::<f64>::identity(s2, s2)) * &free_positions;
-        let svd = a.svd(true, true);
-        let tol = 1e-13 * svd.singular_values.max();
-        let Ok(z) = svd.solve(&(-&r), tol) else {
-            break;
-        };
-        let delta = &free_positions * z;
-        let step = delta.amax();
-        if iteration == 1 && matches!(goal, Goal::Exact) {
-            first = Some((multipliers_of(&phi), step));
-        }
-        if let Goal::Compare { reference, kappa } = goal {
-            if kappa * step <= 0.01 * distance(reference, &multipliers_of(&phi)) {
-                break;
-            }
-        }
-        for i in 0..s2 {
-            x0[i] += delta[i] * scale(i);
-        }
-    }
+    let problem = Problem {
+        scales: (scale_q, scale_v),
+        periods: solution.basis().subharmonic(),
+        free_positions: &free_positions,
+        multipliers_of: &multipliers_of,
+        options,
+        goal,
+    };
+    let jacobian = jacobian.and_then(|j| j.in_scales(sys, (scale_q, scale_v)));
+    let outcome = iterate(&problem, &mut flow, &runge_kutta, &mut x0, jacobian)?;
+    let phi = outcome.phi;
     // The exact orbit's start in the model's DOFs, against the HB state there.
-    let mut orbit_start = sys.lift(&x0[..n]);
-    orbit_start.extend(sys.lift(&x0[n..]));
+    let lift = |x: &[f64]| {
+        let mut out = sys.lift(&x[..n]);
+        out.extend(sys.lift(&x[n..]));
+        out
+    };
+    let orbit_start = lift(&x0);
+    let ahead = outcome.ahead.as_deref().map(lift);
     let full_scale_q = if sys.basis.is_none() {
         scale_q
     } else {
@@ -236,12 +189,14 @@ pub(crate) fn shoot(
             multipliers,
             neutral: all.ncols(),
             orbit_correction,
-            polished,
+            polished: outcome.polished,
             orbit_start,
-            steps: earlier_steps + flow.steps(),
+            steps: outcome.earlier_steps + flow.steps(),
             reduction: None,
         },
-        kappa,
+        kappa: outcome.kappa,
+        ahead,
+        jacobian: KeptJacobian::new(phi, sys, (scale_q, scale_v)),
     })
 }
 
@@ -262,140 +217,4 @@ pub(crate) fn distance(a: &[Complex64], b: &[Complex64]) -> f64 {
             .fold(0.0, f64::max)
     };
     one_way(a, b).max(one_way(b, a))
-}
-
-/// The flow over a period: exponentials or Runge–Kutta.
-enum Integration<'c, 'm> {
-    RungeKutta {
-        flow: Flow<'c, 'm>,
-        stepper: Stepper,
-        opts: FlowOptions,
-    },
-    Exponential(ExpFlow<'c, 'm>),
-}
-
-impl Integration<'_, '_> {
-    /// One period of `y = (q, q̇, Φ̃)`; `Ok(false)` if the exponential flow met a law that is
-    /// not affine on its piece.
-    fn period(&mut self, y: &mut [f64]) -> Result<bool> {
-        match self {
-            Integration::RungeKutta {
-                flow,
-                stepper,
-                opts,
-            } => flow.period(y, opts, stepper).map(|()| true),
-            Integration::Exponential(flow) => flow.period(y),
-        }
-    }
-
-    fn steps(&self) -> usize {
-        match self {
-            Integration::RungeKutta { flow, .. } => flow.steps,
-            Integration::Exponential(flow) => flow.steps,
-        }
-    }
-}
-
-/// `(s_q, ω_max, amplitudes)` in the coordinates `sys`: the largest coordinate of the orbit (1
-/// if it is zero), the fastest angular frequency along it,
-/// `max(Ω, sqrt(λ_max(M⁻¹K(t))) + λ_max(M⁻¹D(t))/2)` over the HB samples, which also limits
-/// the integrator's step to `1/ω_max`, and the largest `(|u_e|, |u̇_e|)` of every element.
-/// `harmonics` are the orbit's in these coordinates.
-fn scales(
-    sys: &Coordinates,
-    solution: &Solution,
-    harmonics: &[Complex64],
-) -> (f64, f64, Vec<(f64, f64)>) {
-    let n = sys.len();
-    let omega = solution.basis().omega();
-    let samples = solution.basis().samples().max(16);
-    let (series, rates) = sampled_orbit(solution, harmonics, n, samples);
-    let mut scale_q = series
-        .iter()
-        .flat_map(|s| s.iter())
-        .fold(0.0_f64, |m, v| m.max(v.abs()));
-    if !(scale_q.is_finite() && scale_q > 0.0) {
-        scale_q = 1.0;
-    }
-    // Largest and smallest element stiffness and damping along the orbit, from the samples.
-    let mut k_max = sys.stiffness.clone();
-    let mut d_max = sys.damping.clone();
-    let (mut q, mut v) = (vec![0.0; n], vec![0.0; n]);
-    let mut amplitudes = Vec::with_capacity(sys.weights.len());
-    for (ei, e) in sys.model.elements().iter().enumerate() {
-        let (mut km, mut dm) = (0.0_f64, 0.0_f64);
-        let (mut au, mut adu) = (0.0_f64, 0.0_f64);
-        for j in 0..samples {
-            // The shaft angle Ωt at sample j (ν times the fundamental's).
-            let theta = std::f64::consts::TAU
-                * ((j * solution.basis().subharmonic()) % samples) as f64
-                / samples as f64;
-            for i in 0..n {
-                q[i] = series[i][j];
-                v[i] = rates[i][j];
-            }
-            let (u, du) = (sys.gather(ei, &q), sys.gather(ei, &v));
-            let (k, d) = e.law().derivatives(theta, u, du);
-            km = km.max(k.abs());
-            dm = dm.max(d.abs());
-            au = au.max(u.abs());
-            adu = adu.max(du.abs());
-        }
-        amplitudes.push((au, adu));
-        let mean = e.linear_part();
-        for &(i, wi) in &sys.weights[ei] {
-            for &(j, wj) in &sys.weights[ei] {
-                k_max[(i, j)] += km.max(mean.stiffness.abs()) * wi * wj;
-                d_max[(i, j)] += dm.max(mean.damping.abs()) * wi * wj;
-            }
-        }
-    }
-    let mut omega_max = omega;
-    if let Some(chol) = sys.mass.clone().cholesky() {
-        if let Some(l_inv) = chol.l().try_inverse() {
-            let largest = |a: &DMatrix<f64>| {
-                let s = &l_inv * a * l_inv.transpose();
-                let s = (&s + s.transpose()) * 0.5;
-                s.symmetric_eigenvalues()
-                    .iter()
-                    .fold(0.0_f64, |m, v| m.max(v.abs()))
-            };
-            let w = largest(&k_max).sqrt() + 0.5 * largest(&d_max);
-            if w.is_finite() {
-                omega_max = omega_max.max(w);
-            }
-        }
-    }
-    (scale_q, omega_max, amplitudes)
-}
-
-/// `(q_i(θ_j), q̇_i(θ_j))` of the `n` coordinates with `harmonics` (harmonic-major) at
-/// `samples` equidistant angles, by the recurrence `e^{ikθ} = e^{iθ} e^{i(k-1)θ}` (one sine
-/// and cosine per sample).
-fn sampled_orbit(
-    solution: &Solution,
-    harmonics: &[Complex64],
-    n: usize,
-    samples: usize,
-) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
-    let h = solution.basis().harmonics();
-    let omega = solution.basis().fundamental();
-    let mut q = vec![vec![0.0; samples]; n];
-    let mut v = vec![vec![0.0; samples]; n];
-    for j in 0..samples {
-        let step = Complex64::from_polar(1.0, std::f64::consts::TAU * j as f64 / samples as f64);
-        let mut rot = Complex64::new(1.0, 0.0);
-        for i in 0..n {
-            q[i][j] = harmonics[i].re;
-        }
-        for k in 1..=h {
-            rot *= step;
-            for i in 0..n {
-                let z = harmonics[k * n + i] * rot;
-                q[i][j] += z.re;
-                v[i][j] -= k as f64 * omega * z.im;
-            }
-        }
-    }
-    (q, v)
 }
