@@ -63,6 +63,13 @@ pub struct Reduction {
     pub comparison_dofs: Option<usize>,
 }
 
+/// Largest relative distance of the exact orbit's start from the HB state for which a shooting
+/// from a start predicted by earlier points is kept. Farther, it may have found another
+/// periodic orbit of the same period (the period-1 orbit under a period-2 HB solution after a
+/// period doubling: found by the `--all-branches` test, with multipliers of the wrong orbit),
+/// and the shooting starts again from the HB state.
+const PREDICTED_ORBIT_DISTANCE: f64 = 1e-2;
+
 impl FloquetOptions {
     /// Defaults.
     pub fn new() -> Self {
@@ -147,13 +154,15 @@ impl FloquetOptions {
                 Goal::Exact,
                 jacobian,
             )?;
-            if s.floquet.polished {
+            if s.floquet.polished && s.floquet.orbit_correction <= PREDICTED_ORBIT_DISTANCE {
                 shot = Some(s);
             }
         }
+        // From the HB state with Newton steps (no kept Jacobian): the orbit the HB solution
+        // stands for, whatever the earlier points were.
         let shot = match shot {
             Some(s) => s,
-            None => shoot(&sys, solution, self, Start::Hb, Goal::Exact, jacobian)?,
+            None => shoot(&sys, solution, self, Start::Hb, Goal::Exact, None)?,
         };
         let Shot {
             mut floquet, kappa, ..
