@@ -70,6 +70,13 @@ pub struct Reduction {
 /// and the shooting starts again from the HB state.
 const PREDICTED_ORBIT_DISTANCE: f64 = 1e-2;
 
+/// Whether the shooting starts from the start predicted by earlier points, with chord steps on
+/// the previous point's monodromy matrix. Off: at the branch switch of the backlash chain
+/// (tests/branch_switching.rs, ignored, release) the orbit converged that way to 10 rtol gave
+/// |μ| 1.3e-6 from the reference (also with chord steps from the HB state), where Newton from
+/// the HB state stays within 1e-6; to be understood before it is turned on again.
+const PREDICTED_START: bool = false;
+
 impl FloquetOptions {
     /// Defaults.
     pub fn new() -> Self {
@@ -145,7 +152,10 @@ impl FloquetOptions {
         // with the previous point's monodromy matrix.
         let mut shot = None;
         let jacobian = cache.jacobian.as_ref();
-        if let Some(d) = cache.predicted_correction(omega, 2 * n) {
+        if let Some(d) = cache
+            .predicted_correction(omega, 2 * n)
+            .filter(|_| PREDICTED_START)
+        {
             let s = shoot(
                 &sys,
                 solution,
