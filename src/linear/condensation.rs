@@ -134,8 +134,8 @@ impl Condensation {
     ///
     /// One multi-column solve per harmonic, `Z_k⁻¹ [W | F_k | b]`: the receptance, the linear
     /// response and the test vector `b` that verifies the factor
-    /// ([`SparseDynamicStiffness::verify`]); the harmonics on the cores
-    /// ([`parallel`](super::parallel)).
+    /// ([`SparseDynamicStiffness::verify`]); the harmonics on several threads with
+    /// `HBAL_THREADS`.
     pub fn linear_part(&mut self, f: &[Complex64]) -> Result<CondensedLinear> {
         let (n, m) = (self.z.n(), self.len());
         let h = self.z.harmonics();
