@@ -152,10 +152,10 @@ impl FloquetOptions {
         // with the previous point's monodromy matrix.
         let mut shot = None;
         let jacobian = cache.jacobian.as_ref();
-        if let Some(d) = cache
-            .predicted_correction(omega, 2 * n)
-            .filter(|_| PREDICTED_START)
-        {
+        let predicted = PREDICTED_START
+            .then(|| cache.predicted_correction(omega, 2 * n))
+            .flatten();
+        if let Some(d) = predicted {
             let s = shoot(
                 &sys,
                 solution,
