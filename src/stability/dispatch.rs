@@ -5,7 +5,7 @@
 
 use super::chord::KeptJacobian;
 use super::reduction::{reduced_basis, ModeCache};
-use super::shooting::{distance, shoot, Goal, Shot, Start};
+use super::shooting::{distance, hb_start, shoot, Goal, Shot, Start};
 use super::system::Coordinates;
 use super::{Floquet, FloquetOptions};
 use crate::error::{Error, Result};
@@ -161,9 +161,7 @@ impl FloquetOptions {
         cache.kappa = kappa.or(cache.kappa);
         cache.jacobian = Some(shot.jacobian);
         let correction = floquet.polished.then(|| {
-            let x_hb = (0..n)
-                .map(|i| solution.displacement(i, 0.0))
-                .chain((0..n).map(|i| solution.velocity(i, 0.0)));
+            let x_hb = hb_start(solution);
             let start = shot.ahead.as_ref().unwrap_or(&floquet.orbit_start);
             let d = start.iter().zip(x_hb).map(|(a, b)| a - b);
             (omega, d.collect())
