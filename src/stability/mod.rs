@@ -73,6 +73,7 @@ mod flow;
 mod generator;
 mod integration;
 mod kernels;
+mod kinks;
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
