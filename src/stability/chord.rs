@@ -9,7 +9,8 @@
 //! fraction of one with it ([`record`](super::record)). A chord step that does not reduce the
 //! scaled residual by [`CHORD_RATE`] is not counted against
 //! [`FloquetOptions::max_shooting`] and is followed by a Newton step (its `J` kept for the next
-//! chord steps). The Runge–Kutta flow, whose monodromy matrix comes with every pass, and the
+//! chord steps); a chord step longer than `AHEAD_GAIN` times the residual (a kept `J` near a
+//! singular one) is replaced by a Newton step at once. The Runge–Kutta flow, whose monodromy matrix comes with every pass, and the
 //! comparison of the reduction's estimate ([`Goal::Compare`], which reads the multipliers of
 //! every iterate) take Newton steps only.
 //!
@@ -28,6 +29,11 @@ use num_complex::Complex64;
 
 /// A chord step must reduce the scaled residual at least by this factor.
 pub(crate) const CHORD_RATE: f64 = 0.25;
+
+/// The Newton step ahead of a converged orbit ([`Outcome::ahead`]) and a chord step are taken
+/// up to this many times the residual (at most 9 along the drivetrain's run-up; 10⁷ at a
+/// period doubling, where `Φ̃ - I` is nearly singular).
+const AHEAD_GAIN: f64 = 100.0;
 
 /// A scaled monodromy matrix kept for the chord steps of a later shooting, with the scales
 /// `(s_q, s_v)` and the coordinates it was formed in.
@@ -49,11 +55,22 @@ impl KeptJacobian {
         }
     }
 
-    /// `Φ̃` in the scales `(s_q, s_v)` if it was formed in the coordinates `sys`: with
-    /// `Φ̃ = S⁻¹ Φ S`, `S = diag(s_q I, s_v I)`, entry `(i, j)` times `(s_i/s'_i) (s'_j/s_j)`.
+    /// `Φ̃` in the scales `(s_q, s_v)` if it was formed in the coordinates `sys` or in nearly
+    /// the same ones: with `Φ̃ = S⁻¹ Φ S`, `S = diag(s_q I, s_v I)`, entry `(i, j)` times
+    /// `(s_i/s'_i) (s'_j/s_j)`. A sweep's reduced bases differ from point to point (the
+    /// attachment modes are static responses at a shift that follows the cut-off, which
+    /// follows Ω): a basis within 1 % (largest entry) still gives a chord Jacobian, which
+    /// need only be near.
     pub(crate) fn in_scales(&self, sys: &Coordinates, scales: (f64, f64)) -> Option<DMatrix<f64>> {
         let n = sys.len();
-        if self.phi.nrows() != 2 * n || self.dofs != sys.model.n_dofs() || self.basis != sys.basis {
+        let near = match (&self.basis, &sys.basis) {
+            (None, None) => true,
+            (Some(a), Some(b)) if a.shape() == b.shape() => {
+                (a - b).amax() <= 1e-2 * a.amax().max(b.amax())
+            }
+            _ => false,
+        };
+        if self.phi.nrows() != 2 * n || self.dofs != sys.model.n_dofs() || !near {
             return None;
         }
         let old = |i: usize| if i < n { self.scales.0 } else { self.scales.1 };
@@ -84,8 +101,9 @@ pub(crate) struct Outcome {
     /// `Φ̃` of the final orbit.
     pub(crate) phi: DMatrix<f64>,
     pub(crate) polished: bool,
-    /// Converged: one more Newton step from the final orbit (`(q, q̇)` in the coordinates), the
-    /// best guess of the periodic orbit's start for the next point of a sweep.
+    /// Converged and well-conditioned: one more Newton step from the final orbit (`(q, q̇)` in
+    /// the coordinates), the best guess of the periodic orbit's start for the next point of a
+    /// sweep.
     pub(crate) ahead: Option<Vec<f64>>,
     /// The sensitivity of the multipliers ([`Shot::kappa`](super::shooting::Shot::kappa)),
     /// measured when the first step was a Newton step.
@@ -198,18 +216,23 @@ fn iterate_with<'c, 'm>(
                 break phi;
             }
             // A start for the next point: one more Newton step from the converged orbit, with
-            // its own Φ̃ (not integrated: the next shooting checks its residual).
+            // its own Φ̃ (not integrated: the next shooting checks its residual), unless the
+            // step is more than AHEAD_GAIN times the residual: near a bifurcation Φ̃ - I is
+            // nearly singular, and the step would go anywhere along the critical direction
+            // (towards another orbit, at a period doubling).
             let j = Factored::new(phi, free);
             if let Ok(z) = j.svd.solve(&(-&r), j.tol) {
                 let delta = free * z;
-                ahead = Some((0..s2).map(|i| x0[i] + delta[i] * scale(i)).collect());
+                if delta.amax() <= AHEAD_GAIN * res {
+                    ahead = Some((0..s2).map(|i| x0[i] + delta[i] * scale(i)).collect());
+                }
             }
             break j.phi;
         }
         last_residual = res;
         iteration += 1;
         counted += 1;
-        let fresh = current.is_some() || kept.is_none();
+        let mut fresh = current.is_some() || kept.is_none();
         if fresh {
             let phi = match current.take() {
                 Some(p) => p,
@@ -217,17 +240,20 @@ fn iterate_with<'c, 'm>(
             };
             kept = Some(Factored::new(phi, free));
         }
+        // (J - I) δ̃ = -r̃ with δ̃ orthogonal to rigid-body positions.
+        let solve = |j: &Factored| j.svd.solve(&(-&r), j.tol).ok().map(|z| free * z);
+        let mut delta = solve(kept.as_ref().expect("a Jacobian"));
+        if !fresh && delta.as_ref().is_none_or(|d| d.amax() > AHEAD_GAIN * res) {
+            // A kept Jacobian that is nearly singular (a bifurcation near): Newton instead.
+            kept = Some(Factored::new(flow.monodromy()?, free));
+            fresh = true;
+            delta = solve(kept.as_ref().expect("a Jacobian"));
+        }
         chord = !fresh;
         let j = kept.as_ref().expect("a Jacobian");
-        // (J - I) δ̃ = -r̃ with δ̃ orthogonal to rigid-body positions.
-        let Ok(z) = j.svd.solve(&(-&r), j.tol) else {
-            break if fresh {
-                j.phi.clone()
-            } else {
-                flow.monodromy()?
-            };
+        let Some(delta) = delta else {
+            break j.phi.clone();
         };
-        let delta = free * z;
         let step = delta.amax();
         if iteration == 1 && fresh && exact {
             first = Some(((problem.multipliers_of)(&j.phi), step));

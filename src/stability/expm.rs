@@ -15,6 +15,7 @@
 //! On a narrow block `V` (a few columns) the highest one, `φ_{p+1}(Z) V`, is summed by Horner's
 //! rule and the others follow from `φ_j(Z) = Z φ_{j+1}(Z) + I/j!`.
 
+use super::kernels::{product, product_scaled};
 use nalgebra::DMatrix;
 
 /// `1/i!` for `i <= 24`.
@@ -56,9 +57,11 @@ impl Powers {
     }
 
     pub(crate) fn new(a: DMatrix<f64>) -> Self {
-        let a2 = &a * &a;
-        let a3 = &a2 * &a;
-        let a4 = &a2 * &a2;
+        let square = || DMatrix::zeros(a.nrows(), a.ncols());
+        let (mut a2, mut a3, mut a4) = (square(), square(), square());
+        product(&a, &a, &mut a2);
+        product(&a2, &a, &mut a3);
+        product(&a2, &a2, &mut a4);
         let norm = norm1(&a);
         Self {
             a,
@@ -118,7 +121,7 @@ impl ExpWork {
         block(m4 - 1, &mut acc, false);
         add_scaled(&mut acc, c[4 * m4] * d4, &p.a4);
         for k in (0..m4 - 1).rev() {
-            self.tmp.gemm(d4, &p.a4, &acc, 0.0);
+            product_scaled(d4, &p.a4, &acc, &mut self.tmp);
             std::mem::swap(&mut acc, &mut self.tmp);
             block(k, &mut acc, true);
         }
@@ -131,7 +134,7 @@ impl ExpWork {
         let s = squarings(p.norm * t.abs());
         self.taylor(p, t / f64::powi(2.0, s as i32), out);
         for _ in 0..s {
-            self.tmp.gemm(1.0, out, out, 0.0);
+            product(out, out, &mut self.tmp);
             out.copy_from(&self.tmp);
         }
     }
@@ -176,14 +179,14 @@ pub(crate) fn phi_narrow(
     top.copy_from(v);
     *top *= c[terms + p + 1];
     for i in (0..terms).rev() {
-        tmp.gemm(1.0, z, top, 0.0);
+        product(z, top, tmp);
         top.copy_from(tmp);
         add_scaled(top, c[i + p + 1], v);
     }
     for j in (1..=p).rev() {
         // φ_j V = Z φ_{j+1} V + V/j!
         let (lo, hi) = out.split_at_mut(j);
-        lo[j - 1].gemm(1.0, z, &hi[0], 0.0);
+        product(z, &hi[0], &mut lo[j - 1]);
         add_scaled(&mut lo[j - 1], c[j], v);
     }
 }

@@ -35,7 +35,8 @@
 
 use super::expm::ExpWork;
 use super::generator::{Expansion, Forcing, State};
-use super::kernels::gemv;
+use super::kernels::gemv_sum;
+use super::kinks::Kinked;
 use super::pieces::Pieces;
 use super::pipeline::{Link, Message};
 use super::record::{Assembler, Step};
@@ -46,20 +47,20 @@ use std::collections::HashMap;
 
 /// The flow over one period by exponentials.
 pub(crate) struct ExpFlow<'c, 'm> {
-    sys: &'c Coordinates<'m>,
-    n: usize,
+    pub(super) sys: &'c Coordinates<'m>,
+    pub(super) n: usize,
     omega: f64,
     bounds: Vec<f64>,
-    pieces: Pieces,
-    scale_q: f64,
-    scale_v: f64,
+    pub(super) pieces: Pieces,
+    pub(super) scale_q: f64,
+    pub(super) scale_v: f64,
     /// The sub-step δ₀ (a power of two).
     delta0: f64,
     max_steps: usize,
     /// `Ã` of the structure alone.
     base: DMatrix<f64>,
     /// `M⁻¹ w_e` (unscaled).
-    mw: Vec<DVector<f64>>,
+    pub(super) mw: Vec<DVector<f64>>,
     forcing: Forcing,
     /// The oscillator's turn over δ₀.
     turns: Vec<(f64, f64)>,
@@ -68,7 +69,9 @@ pub(crate) struct ExpFlow<'c, 'm> {
     pub(super) states: Vec<State>,
     index: HashMap<Vec<u64>, usize>,
     /// The Taylor series of the exact solution from the last expansion point.
-    taylor: Expansion,
+    pub(super) taylor: Expansion,
+    /// The elements with kinks.
+    pub(super) kinks: Kinked,
     /// Integration steps (sub-steps and remainders) over all periods.
     pub(crate) steps: usize,
     /// The monodromy side, here or (linked) on another thread.
@@ -125,12 +128,14 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         let delta0 = f64::powi(2.0, -(fastest.log2().ceil() as i32));
         let turns = forcing.turns(delta0);
         let assembler = Box::new(Assembler::new(2 * n, &sys.weights, &mw));
+        let pieces = Pieces::new(sys);
+        let kinks = Kinked::new(sys, |e| pieces.has_kinks(e), scale_q, scale_v);
         Ok(Self {
             sys,
             n,
             omega,
             bounds: crate::timesim::segment_bounds(sys.model),
-            pieces: Pieces::new(sys),
+            pieces,
             scale_q,
             scale_v,
             delta0,
@@ -143,6 +148,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             states: Vec::new(),
             index: HashMap::new(),
             taylor: Expansion::default(),
+            kinks,
             steps: 0,
             assembler,
             link: None,
@@ -193,16 +199,6 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         }
     }
 
-    /// `(u, u̇)` of element `e` at the scaled state `x̃`.
-    fn element_state(&self, e: usize, x: &DVector<f64>) -> (f64, f64) {
-        let n = self.n;
-        let sys = self.sys;
-        (
-            self.scale_q * sys.gather(e, &x.as_slice()[..n]),
-            self.scale_v * sys.gather(e, &x.as_slice()[n..]),
-        )
-    }
-
     /// `true` if every law at `x̃` and `theta` still has the piece's coefficients.
     fn still_affine(&self, piece: &Piece, x: &DVector<f64>, theta: f64) -> bool {
         piece
@@ -234,8 +230,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         });
         let mut z = DVector::zeros(self.forcing.states());
         let mut x_new = DVector::zeros(s2);
-        let elements = self.mw.len();
-        let (mut at_start, mut at_end) = (vec![(0.0, 0.0); elements], vec![(0.0, 0.0); elements]);
+        let kinked = 2 * self.kinks.elements.len();
+        let (mut at_start, mut at_end) = (vec![0.0; kinked], vec![0.0; kinked]);
         self.pieces.init(self.sys, &y[..n], &y[n..s2]);
         let (omega, delta0) = (self.omega, self.delta0);
         let bounds = self.bounds.clone();
@@ -263,8 +259,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 self.kink_states(&x, &mut at_start);
                 self.forcing.oscillator(t, &mut z);
                 for _ in 0..whole as usize {
-                    gemv(state.e0(), x.as_slice(), x_new.as_mut_slice(), false);
-                    gemv(&state.x0, z.as_slice(), x_new.as_mut_slice(), true);
+                    let terms = [(state.e0(), x.as_slice()), (&state.x0, z.as_slice())];
+                    gemv_sum(&terms, x_new.as_mut_slice(), false);
                     self.kink_states(&x_new, &mut at_end);
                     hit = self.first_crossing(&at_start, &at_end, delta0);
                     if hit.is_some() {
@@ -329,64 +325,5 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             });
         }
         Ok(true)
-    }
-
-    /// `(u, u̇)` of every element with kinks at the scaled state `x̃` (the others untouched).
-    fn kink_states(&self, x: &DVector<f64>, out: &mut [(f64, f64)]) {
-        for (e, o) in out.iter_mut().enumerate() {
-            if self.pieces.has_kinks(e) {
-                *o = self.element_state(e, x);
-            }
-        }
-    }
-
-    /// The earliest kink crossing over a time `h` with the elements' `(u, u̇)` going from
-    /// `start` to `end`: `(fraction, element, upwards?)`.
-    fn first_crossing(
-        &self,
-        start: &[(f64, f64)],
-        end: &[(f64, f64)],
-        h: f64,
-    ) -> Option<(f64, usize, bool)> {
-        let mut best: Option<(f64, usize, bool)> = None;
-        for (e, (&(u0, du0), &(u1, du1))) in start.iter().zip(end).enumerate() {
-            if !self.pieces.has_kinks(e) {
-                continue;
-            }
-            if let Some((s, up)) = self.pieces.crossing(e, u0, u1, du0, du1, h, self.scale_q) {
-                if best.is_none_or(|(b, _, _)| s < b) {
-                    best = Some((s, e, up));
-                }
-            }
-        }
-        best
-    }
-
-    /// The time `τ <= h` after the expansion point at which element `e`'s `u` reaches the
-    /// edge of its piece (Newton from `guess`); `x` becomes the state there.
-    fn locate(&self, x: &mut DVector<f64>, guess: f64, h: f64, e: usize, up: bool) -> f64 {
-        let (lo, hi) = self.pieces.interval(e);
-        let edge = if up { hi } else { lo };
-        let mut tau = guess;
-        for _ in 0..12 {
-            self.taylor.evaluate(tau, x);
-            let (u, du) = self.element_state(e, x);
-            let g = u - edge;
-            if g.abs() <= 1e-14 * (edge.abs() + self.scale_q) || du == 0.0 {
-                return tau;
-            }
-            tau = (tau - g / du).clamp(1e-3 * guess, h);
-        }
-        self.taylor.evaluate(tau, x);
-        tau
-    }
-
-    /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`: the
-    /// factor of the saltation matrix of its force jump ([`Pieces::cross_jump`]).
-    fn cross(&mut self, e: usize, up: bool, theta: f64, x: &DVector<f64>) -> Option<f64> {
-        let (u, du) = self.element_state(e, x);
-        let omega_s = self.scale_v / self.scale_q;
-        self.pieces
-            .cross_jump(self.sys, e, up, (theta, u, du), omega_s)
     }
 }

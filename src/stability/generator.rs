@@ -16,7 +16,7 @@
 //! `E_{2δ} = E_δ²`, `X_{2δ} = E_δ X_δ + X_δ e^{Sδ}` (two sub-steps in a row).
 
 use super::expm::{inverse_factorial, phi_narrow, squarings, ExpWork, Powers};
-use super::kernels::gemv;
+use super::kernels::{gemv_sum, product};
 use super::system::Coordinates;
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
@@ -33,7 +33,7 @@ pub(crate) struct Forcing {
     dirs: DMatrix<f64>,
     /// `C Sʲ`, `j = 0..=MAX_DEGREE`.
     channels: Vec<DMatrix<f64>>,
-    /// `G C` (n × oscillator states).
+    /// `[0; G C]` (2n × oscillator states: the load on the rates).
     load: DMatrix<f64>,
     /// `S`.
     generator: DMatrix<f64>,
@@ -79,7 +79,9 @@ impl Forcing {
             let next = &channels[j - 1] * &generator;
             channels.push(next);
         }
-        let load = &dirs * &channels[0];
+        let mut load = DMatrix::zeros(2 * n, channels[0].ncols());
+        load.view_mut((n, 0), (n, channels[0].ncols()))
+            .copy_from(&(&dirs * &channels[0]));
         Self {
             omega,
             orders,
@@ -144,10 +146,9 @@ impl Forcing {
             .collect()
     }
 
-    /// `out += G C w` for the oscillator vector `w` (the load's velocity rows; `w = Sⁱ z` gives
-    /// its `i`-th time derivative).
-    pub(crate) fn add_load(&self, w: &DVector<f64>, out: &mut [f64]) {
-        gemv(&self.load, w.as_slice(), out, true);
+    /// `[0; G C]`: the scaled load is `[0; G C] z` (`Sⁱ z` for its `i`-th time derivative).
+    pub(crate) fn load(&self) -> &DMatrix<f64> {
+        &self.load
     }
 
     /// `w ← S w` (each pair `(c, s)` of order `k` becomes `kΩ (-s, c)`, the constant 0).
@@ -223,12 +224,14 @@ impl State {
         for i in 0..m {
             x[(i, 0)] += delta * psi[0][(i, loads)];
         }
+        let (mut doubled, mut squared) = (x.clone(), e.clone());
         for _ in 0..fine {
-            let mut doubled = &e * &x;
+            product(&e, &x, &mut doubled);
             forcing.rotate(&mut x, delta);
             doubled += &x;
-            x = doubled;
-            e = &e * &e;
+            std::mem::swap(&mut x, &mut doubled);
+            product(&e, &e, &mut squared);
+            std::mem::swap(&mut e, &mut squared);
             delta *= 2.0;
         }
         Self {
@@ -255,6 +258,8 @@ impl State {
 #[derive(Default)]
 pub(crate) struct Expansion {
     derivs: Vec<DVector<f64>>,
+    /// The oscillator's `Sⁱ z` (a buffer).
+    z: DVector<f64>,
     terms: usize,
 }
 
@@ -271,8 +276,11 @@ impl Expansion {
     ) {
         let m = x.len();
         let n = m / 2;
-        let mut z = DVector::zeros(forcing.states());
-        forcing.oscillator(t, &mut z);
+        let z = &mut self.z;
+        if z.len() != forcing.states() {
+            *z = DVector::zeros(forcing.states());
+        }
+        forcing.oscillator(t, z);
         if self.derivs.is_empty() {
             self.derivs.push(DVector::zeros(m));
         }
@@ -286,10 +294,14 @@ impl Expansion {
             }
             let (done, next) = self.derivs.split_at_mut(i + 1);
             let next = &mut next[0];
-            gemv(state.a(), done[i].as_slice(), next.as_mut_slice(), false);
+            // x̃⁽ⁱ⁺¹⁾ = Ã x̃⁽ⁱ⁾ + [0; G C] Sⁱ z.
+            let terms = [
+                (state.a(), done[i].as_slice()),
+                (forcing.load(), z.as_slice()),
+            ];
+            gemv_sum(&terms, next.as_mut_slice(), false);
             let v = &mut next.as_mut_slice()[n..];
-            forcing.add_load(&z, v);
-            forcing.differentiate(&mut z);
+            forcing.differentiate(z);
             if i == 0 {
                 for (o, c) in v.iter_mut().zip(&state.offset.as_slice()[n..]) {
                     *o += c;

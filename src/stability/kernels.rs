@@ -1,9 +1,9 @@
 //! The small dense kernels of the exponential flow's inner loops, with AVX2/FMA where the CPU
 //! has them (the crate is compiled for the baseline x86-64: SSE2, no FMA).
 //!
-//! * [`gemv`]: `y = A x` or `y += A x` for a column-major `m × k` matrix, eight rows at a
-//!   time held in registers over all `k` columns (the state's sub-steps `x̃ ← E x̃ + X z` and the
-//!   Taylor coefficients `Ã x̃⁽ⁱ⁾` of the orbit: 2n = 40 rows);
+//! * [`gemv`], [`gemv_sum`]: `y = Σ A_k x_k` or `y += …` for column-major matrices, sixteen
+//!   or eight rows at a time held in registers over all columns (the state's sub-steps
+//!   `x̃ ← E x̃ + X z` and the Taylor coefficients `Ã x̃⁽ⁱ⁾` of the orbit: 2n = 40 rows);
 //! * [`horner`]: `out = Σ_{i<=d} τⁱ Tᵢ` by Horner's rule elementwise over matrices `Tᵢ` (the
 //!   short exponential `e^{Ãτ}` from the kept `Ãⁱ/i!`);
 //! * [`product`]: `C = A B` by faer's matrix product (the monodromy matrix's factors).
@@ -27,21 +27,36 @@ fn fast() -> bool {
 
 /// `y = A x` (`add`: `y += A x`) with `A` column-major, `y.len()` rows and `x.len()` columns.
 pub(crate) fn gemv(a: &DMatrix<f64>, x: &[f64], y: &mut [f64], add: bool) {
-    assert!(a.nrows() == y.len() && a.ncols() == x.len());
+    gemv_sum(&[(a, x)], y, add);
+}
+
+/// `y = Σ A_k x_k` (`add`: `y += Σ A_k x_k`) over the pairs `(A_k, x_k)`, each row's sum in
+/// the pairs' and columns' order (so the same bits as one [`gemv`] after another).
+pub(crate) fn gemv_sum(terms: &[(&DMatrix<f64>, &[f64])], y: &mut [f64], add: bool) {
+    let mut slices = [(&[][..], &[][..]); 4];
+    assert!(terms.len() <= slices.len());
+    for (s, &(a, x)) in slices.iter_mut().zip(terms) {
+        assert!(a.nrows() == y.len() && a.ncols() == x.len());
+        *s = (a.as_slice(), x);
+    }
+    let terms = &slices[..terms.len()];
     #[cfg(target_arch = "x86_64")]
     {
         if fast() {
             // SAFETY: the CPU supports the features the function is compiled for.
-            return unsafe { gemv_avx2_fma(a.as_slice(), x, y, add) };
+            return unsafe { gemv_avx2_fma(terms, y, add) };
         }
     }
-    gemv_kernel::<false>(a.as_slice(), x, y, add)
+    gemv_kernel::<false>(terms, y, add)
 }
+
+/// Pairs (column-major matrix, vector) of a [`gemv_sum`].
+type Terms<'a> = [(&'a [f64], &'a [f64])];
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn gemv_avx2_fma(a: &[f64], x: &[f64], y: &mut [f64], add: bool) {
-    gemv_kernel::<true>(a, x, y, add)
+unsafe fn gemv_avx2_fma(terms: &Terms, y: &mut [f64], add: bool) {
+    gemv_kernel::<true>(terms, y, add)
 }
 
 /// Multiply-add `a b + c`, fused with `FMA` (only where the CPU has it: otherwise `mul_add` is
@@ -55,31 +70,68 @@ fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
     }
 }
 
+/// Rows `r..r + R` of `Σ A_k x_k` (matrices with `m` rows), accumulated onto `init` in
+/// registers over every column.
 #[inline(always)]
-fn gemv_kernel<const FMA: bool>(a: &[f64], x: &[f64], y: &mut [f64], add: bool) {
-    const R: usize = 8;
-    let m = y.len();
-    let mut r = 0;
-    while r + R <= m {
-        let mut acc = [0.0; R];
-        if add {
-            acc.copy_from_slice(&y[r..r + R]);
-        }
-        for (j, &xj) in x.iter().enumerate() {
-            let col = &a[j * m + r..j * m + r + R];
+fn rows<const FMA: bool, const R: usize>(
+    terms: &Terms,
+    m: usize,
+    r: usize,
+    init: [f64; R],
+) -> [f64; R] {
+    let mut acc = init;
+    for &(a, x) in terms {
+        for (col, &xj) in a.chunks_exact(m).zip(x) {
+            let c = &col[r..r + R];
             for i in 0..R {
-                acc[i] = madd::<FMA>(col[i], xj, acc[i]);
+                acc[i] = madd::<FMA>(c[i], xj, acc[i]);
             }
         }
-        y[r..r + R].copy_from_slice(&acc);
-        r += R;
     }
-    for (i, yi) in y.iter_mut().enumerate().skip(r) {
-        let mut s = if add { *yi } else { 0.0 };
-        for (j, &xj) in x.iter().enumerate() {
-            s = madd::<FMA>(a[j * m + i], xj, s);
+    acc
+}
+
+/// Blocks of sixteen rows, then eight, then the last eight rows again (the overlap recomputed
+/// to the same bits, from the entries `y` had before) instead of a scalar tail.
+#[inline(always)]
+fn gemv_kernel<const FMA: bool>(terms: &Terms, y: &mut [f64], add: bool) {
+    let m = y.len();
+    if m < 8 {
+        for (i, yi) in y.iter_mut().enumerate() {
+            let mut s = if add { *yi } else { 0.0 };
+            for &(a, x) in terms {
+                for (col, &xj) in a.chunks_exact(m).zip(x) {
+                    s = madd::<FMA>(col[i], xj, s);
+                }
+            }
+            *yi = s;
         }
-        *yi = s;
+        return;
+    }
+    let start = |y: &[f64], r: usize| -> [f64; 8] {
+        let mut init = [0.0; 8];
+        if add {
+            init.copy_from_slice(&y[r..r + 8]);
+        }
+        init
+    };
+    let last = start(y, m - 8);
+    let mut r = 0;
+    while r + 16 <= m {
+        let mut init = [0.0; 16];
+        if add {
+            init.copy_from_slice(&y[r..r + 16]);
+        }
+        y[r..r + 16].copy_from_slice(&rows::<FMA, 16>(terms, m, r, init));
+        r += 16;
+    }
+    if r + 8 <= m {
+        let init = start(y, r);
+        y[r..r + 8].copy_from_slice(&rows::<FMA, 8>(terms, m, r, init));
+        r += 8;
+    }
+    if r < m {
+        y[m - 8..].copy_from_slice(&rows::<FMA, 8>(terms, m, m - 8, last));
     }
 }
 
@@ -133,6 +185,16 @@ fn horner_kernel<const FMA: bool>(terms: &[DMatrix<f64>], tau: f64, out: &mut [f
 /// `out = a b` (faer's kernel: faster than nalgebra's on the 40 × 40 factors of the monodromy
 /// matrix).
 pub(crate) fn product(a: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    product_scaled(1.0, a, b, out);
+}
+
+/// `out = α a b`.
+pub(crate) fn product_scaled(
+    alpha: f64,
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    out: &mut DMatrix<f64>,
+) {
     use faer::linalg::matmul::matmul;
     use faer::{Accum, MatMut, MatRef, Par};
     let (m, k, n) = (a.nrows(), a.ncols(), b.ncols());
@@ -140,7 +202,7 @@ pub(crate) fn product(a: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>
     let a = MatRef::from_column_major_slice(a.as_slice(), m, k);
     let b = MatRef::from_column_major_slice(b.as_slice(), k, n);
     let c = MatMut::from_column_major_slice_mut(out.as_mut_slice(), m, n);
-    matmul(c, Accum::Replace, a, b, 1.0, Par::Seq);
+    matmul(c, Accum::Replace, a, b, alpha, Par::Seq);
 }
 
 #[cfg(test)]
@@ -149,7 +211,7 @@ mod tests {
 
     #[test]
     fn the_kernels_match_nalgebra() {
-        for (m, k) in [(40, 40), (34, 5), (7, 3), (17, 17)] {
+        for (m, k) in [(40, 40), (34, 5), (7, 3), (17, 17), (8, 2), (26, 4)] {
             let a = DMatrix::from_fn(m, k, |i, j| ((3 * i + 7 * j) as f64).sin());
             let x: Vec<f64> = (0..k).map(|j| (j as f64 * 0.3).cos()).collect();
             let xv = nalgebra::DVector::from_column_slice(&x);
@@ -161,6 +223,13 @@ mod tests {
             gemv(&a, &x, &mut y, true);
             let err = y.iter().zip(exact.iter()).map(|(p, q)| (p - 2.0 * q).abs());
             assert!(err.fold(0.0, f64::max) < 1e-14);
+            // Two pairs in one sum: the bits of one product after the other.
+            let mut two = vec![0.25; m];
+            gemv_sum(&[(&a, &x), (&a, &x)], &mut two, true);
+            let mut one = vec![0.25; m];
+            gemv(&a, &x, &mut one, true);
+            gemv(&a, &x, &mut one, true);
+            assert_eq!(two, one);
         }
         let terms: Vec<DMatrix<f64>> = (0..5)
             .map(|i| DMatrix::from_fn(6, 6, |r, c| ((r + 2 * c + i) as f64).cos()))

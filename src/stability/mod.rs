@@ -24,7 +24,10 @@
 //! next to the HB solution, to the integrator's tolerance, whatever H; the size of that
 //! correction ([`Floquet::orbit_correction`]) measures the HB solution's own error at `t = 0`.
 //! A sweep's points share a [`FloquetCache`] (the modes of a reduced basis, the last orbit
-//! correction as the next shooting's start).
+//! corrections, extrapolated to the next shooting's start, and the last `Φ` as the Jacobian
+//! of its chord steps). The exponential flow integrates the orbit alone and forms `Φ` only for
+//! the orbits that need it, the converged one at least, from the record of its pieces: with
+//! two cores on a second thread while the orbit is integrated (the same `Φ` to the last bit).
 //!
 //! Rigid-body modes give multipliers that are exactly 1 by construction; they are identified
 //! from the model ([`Floquet::neutral`]) and left out of [`Floquet::multipliers`] and the
@@ -73,6 +76,7 @@ mod flow;
 mod generator;
 mod integration;
 mod kernels;
+mod kinks;
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
@@ -187,7 +191,7 @@ pub struct FloquetOptions {
     /// exponential flow itself is exact up to rounding and the located crossings).
     pub rtol: f64,
     /// Newton shooting iterations (0: the multipliers along the orbit started from the HB
-    /// state). Default 6.
+    /// state; a chord step that gains less than a factor 4 is not counted). Default 6.
     pub max_shooting: usize,
     /// Steps per period before giving up. Default 2 000 000.
     pub max_steps: usize,

@@ -40,6 +40,8 @@ pub(crate) struct Link {
     abandoned: Arc<AtomicUsize>,
     /// The current pass (numbered from 1).
     pass: usize,
+    /// The last `Φ̃` received, with its pass (asked for again, it is not waited for again).
+    received: Option<(usize, Result<DMatrix<f64>>)>,
 }
 
 impl Link {
@@ -57,11 +59,15 @@ impl Link {
     }
 
     /// `Φ̃` of the current pass (after [`Message::End`]).
-    pub(crate) fn monodromy(&self) -> Result<DMatrix<f64>> {
+    pub(crate) fn monodromy(&mut self) -> Result<DMatrix<f64>> {
         loop {
+            if let Some((pass, phi)) = &self.received {
+                if *pass == self.pass {
+                    return phi.clone();
+                }
+            }
             match self.from.recv() {
-                Ok((pass, phi)) if pass == self.pass => return phi,
-                Ok(_) => continue,
+                Ok(reply) => self.received = Some(reply),
                 Err(_) => {
                     return Err(Error::Solver {
                         reason: "the monodromy matrix's thread stopped".into(),
@@ -133,6 +139,7 @@ impl<'c, 'm> Integration<'c, 'm> {
             from,
             abandoned,
             pass: 0,
+            received: None,
         });
         std::thread::scope(|scope| {
             let handle = scope.spawn(move || assembler.serve(messages, replies, shared));

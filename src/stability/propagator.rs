@@ -15,7 +15,7 @@
 
 use super::expm::{inverse_factorial, ExpWork};
 use super::generator::Core;
-use super::kernels::{horner, product};
+use super::kernels::{horner, product, product_scaled};
 use nalgebra::DMatrix;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -104,7 +104,8 @@ impl Propagator {
                 p.a4() / 24.0,
             ];
             for i in 5..=16 {
-                let next = &self.terms[i - 1] * &p.a / i as f64;
+                let mut next = DMatrix::zeros(m, m);
+                product_scaled(1.0 / i as f64, &self.terms[i - 1], &p.a, &mut next);
                 self.terms.push(next);
             }
         }

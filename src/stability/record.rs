@@ -143,7 +143,7 @@ impl ExpFlow<'_, '_> {
     /// The scaled monodromy matrix `Φ̃` of the pass that wrote `record`: from the linked
     /// assembler, or by replaying the record.
     pub(crate) fn monodromy(&mut self, record: &[Step]) -> Result<DMatrix<f64>> {
-        if let Some(link) = &self.link {
+        if let Some(link) = &mut self.link {
             return link.monodromy();
         }
         let assembler = &mut self.assembler;

@@ -71,14 +71,20 @@ pub(crate) fn shoot(
     let harmonics: Vec<Complex64> = if sys.basis.is_none() {
         solution.harmonics()[..(h + 1) * n_model].to_vec()
     } else {
-        let mut out = Vec::with_capacity((h + 1) * n);
-        for k in 0..=h {
-            let block = &solution.harmonics()[k * n_model..(k + 1) * n_model];
-            let re = sys.project(&block.iter().map(|z| z.re).collect::<Vec<_>>());
-            let im = sys.project(&block.iter().map(|z| z.im).collect::<Vec<_>>());
-            out.extend(re.iter().zip(&im).map(|(&a, &b)| Complex64::new(a, b)));
-        }
-        out
+        // Columns (Re Q_k, Im Q_k), k = 0..=H, projected together.
+        let all = solution.harmonics();
+        let parts = DMatrix::from_fn(n_model, 2 * (h + 1), |i, c| {
+            let z = all[(c / 2) * n_model + i];
+            if c % 2 == 0 {
+                z.re
+            } else {
+                z.im
+            }
+        });
+        let p = sys.project(&parts);
+        (0..(h + 1) * n)
+            .map(|j| Complex64::new(p[(j % n, 2 * (j / n))], p[(j % n, 2 * (j / n) + 1)]))
+            .collect()
     };
     let (scale_q, omega_max, amplitudes) = scales(sys, solution, &harmonics);
     let scale_v = scale_q * omega_max;
@@ -107,10 +113,7 @@ pub(crate) fn shoot(
     };
     let s2 = 2 * n;
     // The HB state at t = 0 in the model's DOFs and in these coordinates.
-    let x_hb: Vec<f64> = (0..n_model)
-        .map(|i| solution.displacement(i, 0.0))
-        .chain((0..n_model).map(|i| solution.velocity(i, 0.0)))
-        .collect();
+    let x_hb = hb_start(solution);
     if x_hb.iter().any(|v| !v.is_finite()) {
         return Err(Error::NonFinite {
             what: "initial state of the Floquet analysis".into(),
@@ -122,8 +125,8 @@ pub(crate) fn shoot(
         Start::State(s) if usable(s) => s.to_vec(),
         _ => x_hb.clone(),
     };
-    let mut x0 = sys.project(&from[..n_model]);
-    x0.extend(sys.project(&from[n_model..]));
+    let x0 = sys.project(&DMatrix::from_column_slice(n_model, 2, &from));
+    let mut x0 = x0.as_slice().to_vec();
     let rigid = neutral::rigid_body_modes(sys);
     let (positions, all) = neutral::state_bases(&rigid);
     let free_positions = neutral::complement(&positions, s2);
@@ -198,6 +201,22 @@ pub(crate) fn shoot(
         ahead,
         jacobian: KeptJacobian::new(phi, sys, (scale_q, scale_v)),
     })
+}
+
+/// The HB state `(q(0), q̇(0))` in the model's DOFs: `q_i(0) = Σ_k Re Q_ik`,
+/// `q̇_i(0) = -Σ_k k ω Im Q_ik` (`ω` the fundamental), the same sums as
+/// [`Solution::displacement`] and [`Solution::velocity`] at `θ = 0` without their rotations.
+pub(crate) fn hb_start(solution: &Solution) -> Vec<f64> {
+    let n = solution.dof_names().len();
+    let h = solution.basis().harmonics();
+    let w = solution.basis().fundamental();
+    let q = (0..n).map(|i| (0..=h).map(|k| solution.harmonic(i, k).re).sum::<f64>());
+    let v = (0..n).map(|i| {
+        (1..=h)
+            .map(|k| -(solution.harmonic(i, k).im * (k as f64 * w)))
+            .sum::<f64>()
+    });
+    q.chain(v).collect()
 }
 
 /// The larger of `max_i min_j |a_i - b_j|` over the leading `a_i` and the same over the

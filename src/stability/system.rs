@@ -103,21 +103,17 @@ impl<'m> Coordinates<'m> {
         }
     }
 
-    /// Coordinates `p` of a model vector `x`: `x` itself, or the M-orthogonal projection
+    /// Coordinates `p` of every column `x` of `xs`: `x` itself, or the M-orthogonal projection
     /// `(VᵀMV)⁻¹ VᵀM x`.
-    pub(crate) fn project(&self, x: &[f64]) -> Vec<f64> {
+    pub(crate) fn project(&self, xs: &DMatrix<f64>) -> DMatrix<f64> {
         let Some(v) = &self.basis else {
-            return x.to_vec();
+            return xs.clone();
         };
-        let mut mx = vec![0.0; x.len()];
-        self.model.mass().mul_add(1.0, x, &mut mx);
-        let rhs = v.transpose() * DVector::from_vec(mx);
-        let p = self
-            .mass
-            .clone()
-            .cholesky()
-            .map_or_else(|| rhs.clone(), |c| c.solve(&rhs));
-        p.as_slice().to_vec()
+        let rhs = v.tr_mul(&sparse_times(self.model.mass(), xs));
+        match self.mass.clone().cholesky() {
+            Some(c) => c.solve(&rhs),
+            None => rhs,
+        }
     }
 
     /// The model vector `V p` of coordinates `p`.
