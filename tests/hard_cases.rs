@@ -80,8 +80,9 @@ fn two_shaft_at_6000_rpm() {
         32,
         [Diverge, Converge, Converge, Converge],
     );
-    // The model is linear in q: one Newton step solves it.
-    assert_eq!(s[1].stats.iterations, 1);
+    // The model is linear in q: the Jacobian is factored once; one Newton step solves the
+    // truncated balance, the next two the tail correction it leaves out (about 8 % at H = 32).
+    assert_eq!(s[1].stats.iterations, 3);
     assert_eq!(s[1].stats.factorizations, 1);
 }
 

@@ -122,6 +122,9 @@ impl ForceLaw for MeshStiffness {
     fn time_order(&self) -> Option<usize> {
         self.profile.time_order(self.teeth)
     }
+    fn is_linear_in_state(&self) -> bool {
+        true
+    }
     fn band_limited(&self, samples: usize, max_order: usize) -> Option<Box<dyn ForceLaw>> {
         let profile = self
             .profile

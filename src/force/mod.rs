@@ -224,6 +224,16 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
         false
     }
 
+    /// `true` if the force is exactly `k(θ) u + d(θ) u̇` (linear in the state, no offset, the
+    /// coefficients possibly varying in time, as a mesh stiffness): where its coefficients
+    /// jump ([`ForceLaw::time_breakpoints`]), the harmonic balance corrects the coupling
+    /// through the harmonics above H (see
+    /// [`HarmonicBasis::with_tail_correction`](crate::HarmonicBasis::with_tail_correction)).
+    /// Default: `false`.
+    fn is_linear_in_state(&self) -> bool {
+        false
+    }
+
     /// Checks the parameters; `context` names the element in messages. Default: accepts.
     fn validate(&self, context: &str) -> Result<()> {
         let _ = context;

@@ -28,10 +28,18 @@ pub struct HarmonicBasis {
     samples: usize,
     #[serde(default = "one")]
     subharmonic: usize,
+    /// Whether the harmonic balance corrects the coupling through the harmonics above H of
+    /// laws whose force jumps in time (see [`HarmonicBasis::with_tail_correction`]).
+    #[serde(default = "yes")]
+    tail: bool,
 }
 
 fn one() -> usize {
     1
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl HarmonicBasis {
@@ -64,6 +72,7 @@ impl HarmonicBasis {
             harmonics,
             samples,
             subharmonic: 1,
+            tail: true,
         })
     }
 
@@ -110,6 +119,7 @@ impl HarmonicBasis {
         let b = Self::new(self.omega, 2 * self.harmonics)?.with_samples(2 * self.samples)?;
         Ok(Self {
             subharmonic: 2 * self.subharmonic,
+            tail: self.tail,
             ..b
         })
     }
@@ -124,6 +134,33 @@ impl HarmonicBasis {
         }
         self.samples = samples;
         Ok(self)
+    }
+
+    /// The same basis with the tail correction on (the default) or off.
+    ///
+    /// Where a force law linear in the state has a coefficient that jumps in time (a
+    /// rectangular mesh stiffness), the exact solution's harmonics above H decay only like
+    /// `l⁻³` and, through the jumps, still feed the kept ones: a plain truncation is good to
+    /// O(H⁻³). The correction adds that feedback, from the Schur complement of the harmonics
+    /// `H < l ≤ L` with their dynamic stiffness taken as diagonal and its receptance
+    /// `G_l ≈ −C/(lΩ)² + B/(lΩ)⁴` between the jumping elements (`C = Wᵀ M⁻¹ W`, `B` so that
+    /// `G_H` is exact), see `residual::tail`. It switches itself off where the harmonics above
+    /// H are not mass-dominated.
+    ///
+    /// ```
+    /// use hbal::HarmonicBasis;
+    /// let b = HarmonicBasis::new(100.0, 32).unwrap();
+    /// assert!(b.tail_correction());
+    /// assert!(!b.with_tail_correction(false).tail_correction());
+    /// ```
+    pub fn with_tail_correction(mut self, on: bool) -> Self {
+        self.tail = on;
+        self
+    }
+
+    /// Whether the tail correction is on ([`HarmonicBasis::with_tail_correction`]).
+    pub fn tail_correction(&self) -> bool {
+        self.tail
     }
 
     /// Ω in rad/s: the excitation (shaft) frequency, the swept parameter.

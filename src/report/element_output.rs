@@ -111,8 +111,9 @@ pub fn element_outputs(model: &Model, sol: &Solution) -> Result<Vec<ElementOutpu
     let n = model.n_dofs();
     let theta: Vec<f64> = (0..samples).map(|j| fine.shaft_angle(j)).collect();
     let (mut u, mut du, mut f) = (vec![0.0; samples], vec![0.0; samples], vec![0.0; samples]);
+    let tail = tail_forces(model, sol)?;
     let mut out = Vec::with_capacity(model.elements().len());
-    for e in model.elements() {
+    for (index, e) in model.elements().iter().enumerate() {
         let coordinate: Vec<Complex64> = (0..=h)
             .map(|k| e.gather(&sol.harmonics()[k * n..(k + 1) * n]))
             .collect();
@@ -169,6 +170,12 @@ pub fn element_outputs(model: &Model, sol: &Solution) -> Result<Vec<ElementOutpu
         let states = states(e, &u);
         let mut force = vec![Complex64::default(); h + 1];
         plan.analyze_into(&mut f, &mut force, &mut scratch);
+        // The coupling through the harmonics above H, which the solve balanced as well.
+        if let Some((_, extra)) = tail.iter().find(|(i, _)| *i == index) {
+            for (f, x) in force.iter_mut().zip(extra) {
+                *f += x;
+            }
+        }
         let single = Solution::from_harmonics(*basis, vec![e.name().to_string()], coordinate, 0.0)?;
         let (umin, umax) = single.extremes(0);
         let coordinate = Signal {
@@ -267,4 +274,24 @@ fn min_max(x: &[f64]) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         })
+}
+
+/// The force harmonics the tail correction added to the elements it corrects
+/// ([`crate::HarmonicBalance::tail_forces`]), from a harmonic balance of the same basis;
+/// none (and no discretisation) where no law can have it.
+fn tail_forces(model: &Model, sol: &Solution) -> Result<Vec<(usize, Vec<Complex64>)>> {
+    let candidate = model.elements().iter().any(|e| {
+        e.law().is_linear_in_state()
+            && e.law().memory().is_none()
+            && !e.law().time_breakpoints().is_empty()
+    });
+    if !candidate || !sol.basis().tail_correction() || sol.basis().harmonics() == 0 {
+        return Ok(Vec::new());
+    }
+    let hb = crate::HarmonicBalance::with_formulation(
+        model,
+        *sol.basis(),
+        crate::linear::Formulation::Auto,
+    )?;
+    Ok(hb.tail_forces(sol.harmonics()))
 }

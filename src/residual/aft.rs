@@ -201,6 +201,10 @@ impl HarmonicBalance<'_> {
                 );
             }
         }
+        // The coupling through the harmonics above H (not in the Jacobian, see `tail`).
+        if let Some(tail) = self.tail.as_deref().filter(|t| t.applies()) {
+            tail.add_into(self, q, out, ws);
+        }
         Ok(())
     }
 

@@ -150,7 +150,9 @@ impl HarmonicBalance<'_> {
         let basis = self.basis.with_omega(omega)?;
         if self.condensed.is_some() {
             self.basis = basis;
-            return self.condense();
+            self.condense()?;
+            self.refit_tail();
+            return Ok(());
         }
         let Some(dense) = self.dense.as_deref() else {
             return Err(Error::Solver {
@@ -162,6 +164,15 @@ impl HarmonicBalance<'_> {
             None => DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?,
         };
         self.basis = basis;
+        self.refit_tail();
         Ok(())
+    }
+
+    /// The tail correction's receptance fitted again to the current factors.
+    fn refit_tail(&mut self) {
+        if let Some(mut tail) = self.tail.take() {
+            tail.fit(self);
+            self.tail = Some(tail);
+        }
     }
 }

@@ -20,6 +20,7 @@
 //! - `real_form`: `R(x)` and `∂R/∂x` in the real layout, the Parseval norm;
 //! - `frequency`: a change of Ω (`Z_k` refactored), `∂R/∂Ω`, the scaling of the alternating load;
 //! - `condensed`: the condensed formulation (unknowns on the element coordinates);
+//! - `tail`: the coupling through the harmonics above H of coefficients that jump in time;
 //! - `limits`: the size estimate checked before anything is allocated.
 
 use crate::error::{Error, Result};
@@ -34,6 +35,7 @@ mod limits;
 mod located;
 mod memory;
 mod real_form;
+mod tail;
 mod workspace;
 use aft::ActiveElement;
 pub use limits::{estimate_bytes, MAX_SYSTEM_BYTES};
@@ -68,6 +70,8 @@ pub struct HarmonicBalance<'m> {
     rigid: Option<std::sync::Arc<crate::model::RigidModes>>,
     /// `cos`, `sin` of `2π m / N` for the Jacobian of laws with memory (empty without them).
     trig: Vec<(f64, f64)>,
+    /// The tail correction (see `tail`), where a law linear in the state jumps in time.
+    tail: Option<Box<tail::TailCorrection>>,
 }
 
 impl<'m> HarmonicBalance<'m> {
@@ -154,6 +158,7 @@ impl<'m> HarmonicBalance<'m> {
             } else {
                 Vec::new()
             },
+            tail: None,
         };
         let mean_load: Vec<f64> = hb.f_ext[..n].iter().map(|v| v.re).collect();
         match formulation.resolve(model) {
@@ -180,6 +185,7 @@ impl<'m> HarmonicBalance<'m> {
                 }
             }
         }
+        hb.tail = tail::TailCorrection::new(&hb)?.map(Box::new);
         Ok(hb)
     }
 
@@ -188,6 +194,42 @@ impl<'m> HarmonicBalance<'m> {
     /// `None` for a grounded model.
     pub fn rigid_modes(&self) -> Option<&crate::model::RigidModes> {
         self.rigid.as_deref()
+    }
+
+    /// Whether the residual includes the tail correction at the current Ω: the coupling
+    /// through the harmonics above H of laws linear in the state whose coefficients jump in
+    /// time (see [`HarmonicBasis::with_tail_correction`]).
+    pub fn tail_corrected(&self) -> bool {
+        self.tail.as_ref().is_some_and(|t| t.applies())
+    }
+
+    /// The force harmonics `0..=H` that the tail correction adds to each corrected element,
+    /// `(element index in the model, harmonics)`, at the full harmonics `q` (`(H+1)·n` of
+    /// the model's DOFs): with them, an element's force balances the equation of motion (see
+    /// [`crate::report::element_outputs`]). Empty where the correction does not apply.
+    pub fn tail_forces(&self, q: &[Complex64]) -> Vec<(usize, Vec<Complex64>)> {
+        let Some(tail) = self.tail.as_deref().filter(|t| t.applies()) else {
+            return Vec::new();
+        };
+        let Some(q) = self.unknowns_of_full(q) else {
+            return Vec::new();
+        };
+        let h = self.basis.harmonics();
+        let mut out = Vec::new();
+        tail.element_forces(self, &q, &mut tail.buffers(), |active, force| {
+            out.push((self.active[active].index, force[..=h].to_vec()));
+        });
+        out
+    }
+
+    /// `true` if every time-varying or nonlinear law is linear in the state
+    /// ([`ForceLaw::is_linear_in_state`](crate::force::ForceLaw::is_linear_in_state)): the
+    /// Jacobian `∂R/∂x` is then the same at every `x`, and Newton factors it once.
+    pub fn is_linear_in_state(&self) -> bool {
+        self.active.iter().all(|a| {
+            let law = self.model.elements()[a.index].law();
+            law.is_linear_in_state() && law.memory().is_none()
+        })
     }
 
     /// The model.

@@ -26,6 +26,8 @@ pub struct AftBuffers {
     pub(super) march: crate::harmonic::march::MarchBuffers,
     /// One local Jacobian column (laws with memory).
     pub(super) column: Vec<f64>,
+    /// The tail correction's buffers (empty without one).
+    pub(super) tail: super::tail::TailBuffers,
     /// Real FFTs done so far.
     pub ffts: usize,
     /// Force-law calls so far.
@@ -74,6 +76,7 @@ impl HarmonicBalance<'_> {
                     crate::harmonic::march::MarchBuffers::new(s, 2 * h + 1)
                 },
                 column: vec![0.0; if self.trig.is_empty() { 0 } else { 2 * h + 1 }],
+                tail: self.tail.as_ref().map(|t| t.buffers()).unwrap_or_default(),
                 ffts: 0,
                 force_evaluations: 0,
             },

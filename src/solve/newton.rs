@@ -119,6 +119,8 @@ pub struct NewtonSolver {
     x_trial: Vec<f64>,
     r_trial: Vec<f64>,
     rel: f64,
+    /// `jac` holds LU factors that stay valid (a Jacobian that does not depend on `x`).
+    factored: bool,
     progress: Progress,
 }
 
@@ -135,6 +137,7 @@ impl NewtonSolver {
             x_trial: vec![0.0; m],
             r_trial: vec![0.0; m],
             rel: f64::INFINITY,
+            factored: false,
             progress: Progress::new(x0, options.max_iterations),
         }
     }
@@ -174,12 +177,18 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
         state: HbState,
     ) -> std::result::Result<(HbState, Option<KV>), argmin::core::Error> {
         let p = problem.problem.as_ref().expect("problem present");
-        p.count_factorization();
-        if !lu::factor_in_place(&mut self.jac, &mut self.perm) {
-            return Ok((
-                self.progress.stop(state, Termination::SingularJacobian),
-                None,
-            ));
+        // Every law linear in the state: the Jacobian is the same at every x, factored once
+        // (the steps after the first take up what it leaves out: the tail correction).
+        let constant = p.hb().is_linear_in_state();
+        if !(constant && self.factored) {
+            p.count_factorization();
+            if !lu::factor_in_place(&mut self.jac, &mut self.perm) {
+                return Ok((
+                    self.progress.stop(state, Termination::SingularJacobian),
+                    None,
+                ));
+            }
+            self.factored = true;
         }
         for (d, r) in self.dx.iter_mut().zip(&self.r) {
             *d = -r;
@@ -211,7 +220,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
         self.rel = rel;
         self.progress.record(rel);
         // The Jacobian for the next step, unless this one is the last.
-        if rel > self.options.tolerance {
+        if rel > self.options.tolerance && !constant {
             if let Err(e) = p.residual(&self.progress.x, &mut self.r, Some(&mut self.jac)) {
                 return Ok((self.progress.stop(state, Termination::from_error(&e)), None));
             }
