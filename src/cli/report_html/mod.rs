@@ -33,6 +33,17 @@ fn percent(v: &Value) -> String {
         .map_or("–".into(), |x| format!("{:.1} %", 100.0 * x))
 }
 
+/// The JSON document of `part`, or `None` after a failed status `no {what}: {error}`.
+fn document<'a>(r: &mut HtmlReport, part: &'a Part, what: &str) -> Option<&'a Value> {
+    if part.doc.is_none() {
+        r.status(
+            false,
+            &format!("no {what}: {}", part.error.as_deref().unwrap_or("unknown")),
+        );
+    }
+    part.doc.as_ref()
+}
+
 /// Inlines `dir/file` as a figure, or says it is missing.
 fn figure(r: &mut HtmlReport, dir: &Path, file: &str, caption: &str) {
     match std::fs::read_to_string(dir.join(file)) {

@@ -1,20 +1,13 @@
 //! The natural frequencies (linearised on the periodic solution), the critical speeds and
 //! the Campbell diagram.
 
-use super::{figure, num, Inputs};
+use super::{document, figure, num, Inputs};
 use hbal::report::HtmlReport;
 
 pub(super) fn modes_section(r: &mut HtmlReport, i: &Inputs) {
     let unit = i.scene.speed_unit;
     r.heading("Natural frequencies and critical speeds");
-    let Some(doc) = &i.moded.doc else {
-        r.status(
-            false,
-            &format!(
-                "no natural frequencies: {}",
-                i.moded.error.as_deref().unwrap_or("unknown")
-            ),
-        );
+    let Some(doc) = document(r, i.moded, "natural frequencies") else {
         return;
     };
     let modes = doc["modes"].as_array().map_or(&[][..], Vec::as_slice);

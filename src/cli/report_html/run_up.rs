@@ -1,7 +1,7 @@
 //! The run-up: its points, folds and stability, where contact opens, the order cuts, the
 //! waterfall and frequency responses.
 
-use super::{figure, num, percent, Inputs};
+use super::{document, figure, num, percent, Inputs};
 use crate::cli::report::Part;
 use hbal::report::{significant, HtmlReport};
 
@@ -11,11 +11,7 @@ const FREQUENCY_RESPONSES: usize = 2;
 pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
     let unit = i.scene.speed_unit;
     r.heading("Run-up");
-    let Some(doc) = &part.doc else {
-        r.status(
-            false,
-            &format!("no run-up: {}", part.error.as_deref().unwrap_or("unknown")),
-        );
+    let Some(doc) = document(r, part, "run-up") else {
         return;
     };
     let points = doc["points"].as_array().map_or(&[][..], Vec::as_slice);

@@ -1,7 +1,7 @@
 //! The periodic solution at the scene's speed: convergence, error estimate, stability, the
 //! time series and spectrum, the DOF and element tables.
 
-use super::{figure, num, percent, Inputs};
+use super::{document, figure, num, percent, Inputs};
 use hbal::report::{significant, HtmlReport};
 use serde_json::Value;
 
@@ -15,14 +15,7 @@ pub(super) fn solve_section(r: &mut HtmlReport, i: &Inputs) {
         crate::cli::speed_text(scene.basis.omega() / scene.omega_per_speed),
         scene.speed_unit
     ));
-    let Some(doc) = &i.solved.doc else {
-        r.status(
-            false,
-            &format!(
-                "no solution: {}",
-                i.solved.error.as_deref().unwrap_or("unknown")
-            ),
-        );
+    let Some(doc) = document(r, i.solved, "solution") else {
         return;
     };
     let converged = doc["converged"].as_bool() == Some(true);
