@@ -12,6 +12,9 @@
 //! 500-point run-up sweep with stability at n = 1000 from one point (two shooting periods, no
 //! estimate, modes reused: see `examples/stability_sweep.rs` for the measured sweep).
 
+mod common;
+
+use common::{cpu_ms, flag, median};
 use hbal::catalog::Drivetrain;
 use hbal::stability::{Floquet, FloquetMethod, FloquetOptions, Integrator};
 use hbal::{Formulation, HarmonicBalance, HarmonicBasis, Newton, Solution};
@@ -20,23 +23,6 @@ use std::time::Instant;
 
 /// Engine speed (rpm).
 const RPM: f64 = 2000.0;
-
-fn argument(name: &str, default: usize) -> usize {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
-/// CPU time of this thread in ms (wall clock where `/proc` is not there).
-fn cpu_ms(start: Instant) -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or_else(|| start.elapsed().as_secs_f64() * 1e3, |ns| ns * 1e-6)
-}
 
 /// The median time of `repeat` analyses and the last result.
 fn timed(
@@ -53,8 +39,7 @@ fn timed(
         last = Some(options.compute(model, solution)?);
         times.push(cpu_ms(origin) - start);
     }
-    times.sort_by(f64::total_cmp);
-    Ok((times[times.len() / 2], last.expect("one run")))
+    Ok((median(times), last.expect("one run")))
 }
 
 /// `max_i min_j |a_i - b_j|` over the leading four of `a`.
@@ -72,9 +57,10 @@ fn distance(a: &Floquet, b: &Floquet) -> f64 {
 }
 
 fn main() -> Result<()> {
-    let max_dofs = argument("--max-dofs", 10_000);
-    let dense_up_to = argument("--dense-up-to", 20);
-    let repeat = argument("--repeat", 3).max(1);
+    let args: Vec<String> = std::env::args().collect();
+    let max_dofs: usize = flag(&args, "--max-dofs", 10_000);
+    let dense_up_to: usize = flag(&args, "--dense-up-to", 20);
+    let repeat = flag(&args, "--repeat", 3_usize).max(1);
     println!("## Floquet multipliers of the drivetrain (m = 4, H = 32, {RPM} rpm)\n");
     println!("CPU ms, median of {repeat}; RK = Dormand–Prince 5(4), rtol 1e-8; exp = exponential flow.\n");
     println!("| n | HB point | basis r + a | one analysis RK | exp | ratio | with estimate RK | exp | ratio | dense RK | dense exp | max abs(μ) | exp vs RK | exp vs dense | estimate | steps RK / exp |");

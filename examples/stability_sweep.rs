@@ -13,46 +13,14 @@
 //! point (the HB side of `hbal sweep --no-error-estimate`). With `DUMP` set in the environment,
 //! every point's Ω, steps, orbit correction, `polished` and multipliers go to stderr.
 
+mod common;
+
+use common::{cpu_ms, flag, median, process_cpu_ms};
 use hbal::continuation::{Branch, Continuation};
 use hbal::scene::Scene;
 use hbal::stability::FloquetOptions;
 use std::path::Path;
 use std::time::Instant;
-
-fn flag(args: &[String], name: &str, default: f64) -> f64 {
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
-/// CPU time of this thread in ms (wall clock where `/proc` is not there).
-fn cpu_ms(start: Instant) -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or_else(|| start.elapsed().as_secs_f64() * 1e3, |ns| ns * 1e-6)
-}
-
-/// CPU time of the whole process (every thread, also those that have ended) in ms, from
-/// `/proc/self/stat` (ticks of 10 ms); 0 where it is not there.
-fn process_cpu_ms() -> f64 {
-    std::fs::read_to_string("/proc/self/stat")
-        .ok()
-        .and_then(|s| {
-            // After the command name in parentheses: state is field 3, utime 14, stime 15.
-            let rest = &s[s.rfind(')')? + 2..];
-            let f: Vec<&str> = rest.split_whitespace().collect();
-            Some((f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?) * 10.0)
-        })
-        .unwrap_or(0.0)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -65,7 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let unit = scene.omega_per_speed;
     let from = flag(&args, "--from", 1000.0) * unit;
     let to = flag(&args, "--to", 3000.0) * unit;
-    let repeat = flag(&args, "--repeat", 1.0).max(1.0) as usize;
+    let repeat = flag(&args, "--repeat", 1.0_f64).max(1.0) as usize;
     let basis = scene.basis.with_omega(from)?;
     let run = |stability: Option<FloquetOptions>| -> Result<(f64, f64, f64, Branch), hbal::Error> {
         let (mut walls, mut cpus, mut all, mut last) = (Vec::new(), Vec::new(), Vec::new(), None);

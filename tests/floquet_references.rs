@@ -5,67 +5,20 @@
 //! W = 0.7 and 0.8) and the symmetric 3-DOF backlash chain on both sides of its
 //! symmetry-breaking point. Moduli and complex multipliers within 1e-6.
 
+mod common;
+
+use common::floquet::{orbits, reference_multipliers, scene, solve_at};
 use hbal::catalog::GearBacklash;
-use hbal::num_complex::Complex64;
-use hbal::scene::Scene;
 use hbal::stability::floquet;
-use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
+use hbal::Model;
 use serde_json::Value;
-use std::path::Path;
-
-fn orbits(file: &str) -> Vec<Value> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/floquet")
-        .join(file);
-    let text = std::fs::read_to_string(&path).unwrap();
-    serde_json::from_str::<Value>(&text)
-        .unwrap()
-        .as_array()
-        .unwrap()
-        .clone()
-}
-
-fn numbers(v: &Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
-}
-
-/// The reference orbit's leading Fourier coefficients as a warm start `Q_k = a_k - i b_k`.
-fn warm_start(orbit: &Value, n: usize, h: usize) -> Vec<Complex64> {
-    let mut q = vec![Complex64::default(); (h + 1) * n];
-    for f in orbit["fourier"].as_array().unwrap() {
-        let i = f["dof"].as_u64().unwrap() as usize;
-        let (a, b) = (numbers(&f["cos"]), numbers(&f["sin"]));
-        for k in 0..a.len().min(h + 1) {
-            q[k * n + i] = Complex64::new(a[k], -b[k]);
-        }
-    }
-    q
-}
 
 /// Solves `model` at the reference's W from its orbit, then checks the multipliers.
 fn check(label: &str, model: &Model, orbit: &Value, h: usize) {
-    let omega = orbit["W"].as_f64().unwrap();
-    let n = model.n_dofs();
-    let hb = HarmonicBalance::new(model, HarmonicBasis::new(omega, h).unwrap()).unwrap();
-    let sol = Newton::new()
-        .solve_from(&hb, &warm_start(orbit, n, h), &mut hb.workspace())
-        .unwrap();
-    assert!(sol.is_converged(), "{label}: {}", sol.termination);
+    let sol = solve_at(label, model, orbit, h);
     let f = floquet(model, &sol).unwrap();
     assert!(f.polished, "{label}: shooting did not converge: {f:?}");
-    let want: Vec<Complex64> = orbit["multipliers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|m| {
-            let m = numbers(m);
-            Complex64::new(m[0], m[1])
-        })
-        .collect();
+    let want = reference_multipliers(orbit);
     assert_eq!(f.multipliers.len(), want.len(), "{label}");
     for (got, w) in f.multipliers.iter().zip(&want) {
         assert!(
@@ -94,11 +47,7 @@ fn check(label: &str, model: &Model, orbit: &Value, h: usize) {
 #[test]
 fn two_shaft_model_at_60_600_6000_rpm() {
     for rpm in [60, 600, 6000] {
-        let scene = Scene::load(
-            &Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join(format!("examples/scenes/two_shaft_{rpm}rpm.toml")),
-        )
-        .unwrap();
+        let scene = scene(&format!("examples/scenes/two_shaft_{rpm}rpm.toml"));
         for orbit in orbits(&format!("two_shaft_{rpm}rpm.json")) {
             check(&format!("two-shaft {rpm} rpm"), &scene.model, &orbit, 32);
         }
@@ -127,10 +76,7 @@ fn backlash_pair_in_every_regime() {
 
 #[test]
 fn backlash_chain_through_its_symmetry_breaking_point() {
-    let scene = Scene::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/floquet/chain_backlash.toml"),
-    )
-    .unwrap();
+    let scene = scene("tests/data/floquet/chain_backlash.toml");
     let all = orbits("chain_backlash.json");
     assert_eq!(all.len(), 4);
     for orbit in all {

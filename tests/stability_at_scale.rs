@@ -2,37 +2,12 @@
 //! matrix: with every mode kept the reduction is a similarity transform (the same multipliers
 //! to 1e-8); with the automatic cut-off its accuracy estimate bounds the true error.
 
-use hbal::catalog::Drivetrain;
-use hbal::scene::Scene;
+mod common;
+
+use common::floquet::{drivetrain, hausdorff, one_way, scene, solve};
 use hbal::stability::{Floquet, FloquetMethod, FloquetOptions};
-use hbal::{Formulation, HarmonicBalance, HarmonicBasis, Model, Newton, Solution};
+use hbal::{Formulation, Model, Solution};
 use num_complex::Complex64;
-use std::path::Path;
-
-fn scene(file: &str) -> Scene {
-    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap()
-}
-
-fn solve(model: &Model, basis: HarmonicBasis, formulation: Formulation) -> Solution {
-    let hb = HarmonicBalance::with_formulation(model, basis, formulation).unwrap();
-    let s = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
-    assert!(s.is_converged(), "{}", s.termination);
-    s
-}
-
-/// The small drivetrain: coarse teeth (mesh harmonics up to 8), H = 8, 2000 rpm.
-fn drivetrain(n: usize) -> (Model, Solution) {
-    let d = Drivetrain::default().coarse_teeth(4).unwrap().with_dofs(n);
-    let model = d.model().unwrap();
-    let basis = HarmonicBasis::new(d.fundamental(2000.0), 8).unwrap();
-    let s = solve(&model, basis, Formulation::Condensed);
-    (model, s)
-}
-
-/// `max_i min_j |a_i - b_j|` both ways over all multipliers.
-fn hausdorff(a: &[Complex64], b: &[Complex64]) -> f64 {
-    one_way(a, b).max(one_way(b, a))
-}
 
 fn both(model: &Model, solution: &Solution, options: FloquetOptions) -> (Floquet, Floquet) {
     let dense = options
@@ -68,7 +43,7 @@ fn every_mode_kept_gives_the_dense_multipliers() {
 #[test]
 #[ignore]
 fn every_mode_kept_gives_the_dense_multipliers_of_the_drivetrain() {
-    let (model, solution) = drivetrain(20);
+    let (model, solution) = drivetrain(20, 2000.0);
     check_every_mode_kept(vec![("drivetrain n = 20", model, solution)]);
 }
 
@@ -108,13 +83,7 @@ fn check_every_mode_kept(cases: Vec<(&str, Model, Solution)>) {
 #[test]
 #[ignore]
 fn the_estimate_of_the_cut_off_basis_is_truthful() {
-    let d = Drivetrain::default()
-        .coarse_teeth(4)
-        .unwrap()
-        .with_dofs(100);
-    let model = d.model().unwrap();
-    let basis = HarmonicBasis::new(d.fundamental(6000.0), 8).unwrap();
-    let solution = solve(&model, basis, Formulation::Condensed);
+    let (model, solution) = drivetrain(100, 6000.0);
     let (dense, reduced) = both(&model, &solution, FloquetOptions::default());
     let info = reduced.reduction.clone().unwrap();
     let estimate = info.estimate.unwrap();
@@ -149,15 +118,4 @@ fn the_estimate_of_the_cut_off_basis_is_truthful() {
     );
     assert_eq!(dense.is_stable(), reduced.is_stable());
     assert!((dense.max_abs() - reduced.max_abs()).abs() <= error + 1e-12);
-}
-
-/// `max_i min_j |a_i - b_j|`.
-fn one_way(a: &[Complex64], b: &[Complex64]) -> f64 {
-    a.iter()
-        .map(|x| {
-            b.iter()
-                .map(|y| (x - y).norm())
-                .fold(f64::INFINITY, f64::min)
-        })
-        .fold(0.0, f64::max)
 }

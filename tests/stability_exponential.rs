@@ -4,71 +4,19 @@
 //! other laws; the reduction's estimate with the comparison's shortened shooting; and the
 //! [`FloquetCache`] of a sweep.
 
-use hbal::catalog::{Drivetrain, GearBacklash};
+mod common;
+
+use common::floquet::{
+    coarse_drivetrain, drivetrain, hausdorff, orbits, reference_multipliers, scene, solve_at,
+};
+use hbal::catalog::GearBacklash;
 use hbal::continuation::Continuation;
 use hbal::force::{Backlash, CubicSpring, MeshProfile};
 use hbal::nalgebra::DMatrix;
 use hbal::num_complex::Complex64;
-use hbal::scene::Scene;
 use hbal::stability::{Floquet, FloquetCache, FloquetMethod, FloquetOptions, Integrator};
-use hbal::{Formulation, HarmonicBalance, HarmonicBasis, Model, Newton, Solution};
+use hbal::{Formulation, HarmonicBalance, HarmonicBasis, Model, Newton};
 use serde_json::Value;
-use std::path::Path;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn references(file: &str) -> Vec<Value> {
-    let text = std::fs::read_to_string(root().join("tests/data/floquet").join(file)).unwrap();
-    serde_json::from_str::<Value>(&text)
-        .unwrap()
-        .as_array()
-        .unwrap()
-        .clone()
-}
-
-fn numbers(v: &Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
-}
-
-/// Solves `model` at the reference's W, warm-started from its Fourier coefficients.
-fn solve_at(model: &Model, orbit: &Value, h: usize) -> Solution {
-    let n = model.n_dofs();
-    let mut q = vec![Complex64::default(); (h + 1) * n];
-    for f in orbit["fourier"].as_array().unwrap() {
-        let i = f["dof"].as_u64().unwrap() as usize;
-        let (a, b) = (numbers(&f["cos"]), numbers(&f["sin"]));
-        for k in 0..a.len().min(h + 1) {
-            q[k * n + i] = Complex64::new(a[k], -b[k]);
-        }
-    }
-    let basis = HarmonicBasis::new(orbit["W"].as_f64().unwrap(), h).unwrap();
-    let hb = HarmonicBalance::new(model, basis).unwrap();
-    let sol = Newton::new()
-        .solve_from(&hb, &q, &mut hb.workspace())
-        .unwrap();
-    assert!(sol.is_converged());
-    sol
-}
-
-/// `max_i min_j |a_i - b_j|` both ways.
-fn hausdorff(a: &[Complex64], b: &[Complex64]) -> f64 {
-    let one = |a: &[Complex64], b: &[Complex64]| {
-        a.iter()
-            .map(|x| {
-                b.iter()
-                    .map(|y| (x - y).norm())
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .fold(0.0, f64::max)
-    };
-    one(a, b).max(one(b, a))
-}
 
 fn with(integrator: Integrator, rtol: f64) -> FloquetOptions {
     FloquetOptions {
@@ -89,14 +37,13 @@ fn exponential_flow_against_the_references_and_runge_kutta() {
         worst = (worst.0.max(e), worst.1.max(r));
     };
     for rpm in [60, 600, 6000] {
-        let scene =
-            Scene::load(&root().join(format!("examples/scenes/two_shaft_{rpm}rpm.toml"))).unwrap();
-        for orbit in references(&format!("two_shaft_{rpm}rpm.json")) {
+        let scene = scene(&format!("examples/scenes/two_shaft_{rpm}rpm.toml"));
+        for orbit in orbits(&format!("two_shaft_{rpm}rpm.json")) {
             check(&format!("two-shaft {rpm} rpm"), &scene.model, &orbit, 32);
         }
     }
-    let chain = Scene::load(&root().join("tests/data/floquet/chain_backlash.toml")).unwrap();
-    for orbit in references("chain_backlash.json") {
+    let chain = scene("tests/data/floquet/chain_backlash.toml");
+    for orbit in orbits("chain_backlash.json") {
         let label = format!("chain W {}, {}", orbit["W"], orbit["branch"]);
         check(&label, &chain.model, &orbit, 64);
     }
@@ -117,8 +64,8 @@ fn a_cosine_mesh_stiffness_falls_back_on_runge_kutta() {
     }
     .model()
     .unwrap();
-    for orbit in references("gear_backlash_Fa0.3_double_sided.json") {
-        let sol = solve_at(&model, &orbit, 32);
+    for orbit in orbits("gear_backlash_Fa0.3_double_sided.json") {
+        let sol = solve_at("gear pair Fa 0.3", &model, &orbit, 32);
         let auto = with(Integrator::Auto, 1e-8).compute(&model, &sol).unwrap();
         let rk = with(Integrator::RungeKutta, 1e-8)
             .compute(&model, &sol)
@@ -131,16 +78,8 @@ fn a_cosine_mesh_stiffness_falls_back_on_runge_kutta() {
 /// The distances of the exponential and the Runge–Kutta multipliers (default rtol 1e-8) to the
 /// reference's; both flows at rtol 1e-11 against each other.
 fn against_reference(label: &str, model: &Model, orbit: &Value, h: usize) -> (f64, f64) {
-    let sol = solve_at(model, orbit, h);
-    let want: Vec<Complex64> = orbit["multipliers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|m| {
-            let m = numbers(m);
-            Complex64::new(m[0], m[1])
-        })
-        .collect();
+    let sol = solve_at(label, model, orbit, h);
+    let want = reference_multipliers(orbit);
     let exp = with(Integrator::Auto, 1e-8).compute(model, &sol).unwrap();
     let rk = with(Integrator::RungeKutta, 1e-8)
         .compute(model, &sol)
@@ -234,26 +173,12 @@ fn a_cubic_spring_falls_back_on_runge_kutta() {
     assert_eq!(auto.steps, rk.steps);
 }
 
-/// The drivetrain (coarse teeth, H = 8) at 100 DOFs, on the reduced basis.
-fn drivetrain(rpm: f64) -> (Model, Solution) {
-    let d = Drivetrain::default()
-        .coarse_teeth(4)
-        .unwrap()
-        .with_dofs(100);
-    let model = d.model().unwrap();
-    let basis = HarmonicBasis::new(d.fundamental(rpm), 8).unwrap();
-    let hb = HarmonicBalance::with_formulation(&model, basis, Formulation::Condensed).unwrap();
-    let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
-    assert!(sol.is_converged());
-    (model, sol)
-}
-
 /// The estimate's comparison stops its shooting once its multipliers are known to 1 % of
 /// their distance: against the fully polished analysis on the comparison basis (cut-off 6
 /// H Ω instead of 3 H Ω) the estimate is within 2 %.
 #[test]
 fn the_shortened_comparison_gives_the_estimate_within_two_percent() {
-    let (model, sol) = drivetrain(2000.0);
+    let (model, sol) = drivetrain(100, 2000.0);
     let reduced = FloquetOptions::default().with_method(FloquetMethod::Reduced);
     let f = reduced.compute(&model, &sol).unwrap();
     let info = f.reduction.clone().unwrap();
@@ -297,8 +222,8 @@ fn leading_distance(a: &Floquet, b: &Floquet) -> f64 {
 /// does not change.
 #[test]
 fn the_sweep_cache_gives_the_fresh_answer() {
-    let (model, first) = drivetrain(2000.0);
-    let (_, second) = drivetrain(2020.0);
+    let (model, first) = drivetrain(100, 2000.0);
+    let (_, second) = drivetrain(100, 2020.0);
     let options = FloquetOptions {
         estimate: false,
         ..FloquetOptions::default()
@@ -313,10 +238,7 @@ fn the_sweep_cache_gives_the_fresh_answer() {
     assert!(d < 1e-8, "{d:e}");
     assert!((cached.orbit_correction - fresh.orbit_correction).abs() < 1e-6);
 
-    let d = Drivetrain::default()
-        .coarse_teeth(4)
-        .unwrap()
-        .with_dofs(100);
+    let d = coarse_drivetrain(100);
     let basis = HarmonicBasis::new(d.fundamental(2000.0), 8).unwrap();
     let branch = Continuation {
         max_step: 0.5,
@@ -350,7 +272,7 @@ fn the_sweep_cache_gives_the_fresh_answer() {
 #[test]
 #[ignore]
 fn the_large_scene_against_runge_kutta() {
-    let scene = Scene::load(&root().join("examples/scenes/large/drivetrain_1000.toml")).unwrap();
+    let scene = scene("examples/scenes/large/drivetrain_1000.toml");
     let hb =
         HarmonicBalance::with_formulation(&scene.model, scene.basis, Formulation::Auto).unwrap();
     let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();

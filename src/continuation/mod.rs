@@ -16,6 +16,7 @@
 
 mod arclength;
 mod bordered;
+mod locate;
 mod parameter;
 mod point;
 mod speed_homotopy;

@@ -129,6 +129,17 @@ impl Factored {
     }
 }
 
+/// `Φ̃` of the last pass: `known` where it came with the pass, else the flow's (computed now).
+fn pass_monodromy(
+    known: Option<DMatrix<f64>>,
+    flow: &mut Integration<'_, '_>,
+) -> Result<DMatrix<f64>> {
+    match known {
+        Some(phi) => Ok(phi),
+        None => flow.monodromy(),
+    }
+}
+
 /// Iterates `x0` (`(q, q̇)` in the coordinates) to the periodic orbit with the flow `flow`
 /// (replaced by `runge_kutta()` where the exponential flow meets a law that is not affine),
 /// starting the chord steps with `jacobian` if given.
@@ -183,10 +194,7 @@ fn iterate_with<'c, 'm>(
         let r = DVector::from_fn(s2, |i, _| (x_end[i] - x0[i]) / scale(i));
         let res = r.amax();
         if let (1, Some((mu, step))) = (iteration, &first) {
-            let phi = match current.take() {
-                Some(p) => p,
-                None => flow.monodromy()?,
-            };
+            let phi = pass_monodromy(current.take(), flow)?;
             kappa = Some(distance(mu, &(problem.multipliers_of)(&phi)) / step);
             current = Some(phi);
         }
@@ -208,10 +216,7 @@ fn iterate_with<'c, 'm>(
             false
         };
         if stop {
-            let phi = match current {
-                Some(p) => p,
-                None => flow.monodromy()?,
-            };
+            let phi = pass_monodromy(current, flow)?;
             if !polished {
                 break phi;
             }
@@ -234,10 +239,7 @@ fn iterate_with<'c, 'm>(
         counted += 1;
         let mut fresh = current.is_some() || kept.is_none();
         if fresh {
-            let phi = match current.take() {
-                Some(p) => p,
-                None => flow.monodromy()?,
-            };
+            let phi = pass_monodromy(current.take(), flow)?;
             kept = Some(Factored::new(phi, free));
         }
         // (J - I) δ̃ = -r̃ with δ̃ orthogonal to rigid-body positions.

@@ -16,17 +16,20 @@
 //! restart where the frozen state stops being the true one (the module `timesim::memory` in the source).
 
 mod memory;
+mod period;
 mod rhs;
+mod scale;
 
 use crate::error::{Error, Result};
 use crate::harmonic::{AftPlan, HarmonicBasis};
 use crate::model::Model;
-use differential_equations::prelude::*;
-use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
-use rhs::{LastPoint, Rhs};
+use rhs::Rhs;
+use scale::state_scale;
 use std::f64::consts::TAU;
 use std::time::{Duration, Instant};
+
+pub(crate) use period::segment_bounds;
 
 /// Options of the time-domain reference.
 #[derive(Debug, Clone, PartialEq)]
@@ -252,174 +255,4 @@ impl TimeSimulation {
         }
         Ok(())
     }
-
-    /// Integrates period `p` segment by segment; optionally samples q at N equidistant angles.
-    #[allow(clippy::too_many_arguments)]
-    fn integrate_period(
-        &self,
-        rhs: &Rhs,
-        bounds: &[f64],
-        p: usize,
-        period: f64,
-        atol: &[f64],
-        y: &mut Vec<f64>,
-        mut samples: Option<&mut Vec<Vec<f64>>>,
-        steps: &mut usize,
-        evals: &mut usize,
-    ) -> Result<()> {
-        let n = y.len() / 2;
-        let t_period = p as f64 * period;
-        let omega = TAU / period;
-        for w in bounds.windows(2) {
-            let (ta, tb) = (t_period + w[0] / omega, t_period + w[1] / omega);
-            rhs.enter_segment(ta, w[0], w[1]);
-            let mut method = ExplicitRungeKutta::dop853()
-                .rtol(self.rtol)
-                .atol(atol.to_vec())
-                .max_steps(usize::MAX / 4);
-            if let Some(h) = self.max_step {
-                method = method.h_max(h * period);
-            }
-            let y0 = y.clone();
-            let (t_end, y_end) = if rhs.has_memory() {
-                memory::integrate_segment(
-                    rhs,
-                    (self.rtol, atol, self.max_step.map(|h| h * period)),
-                    (ta, tb),
-                    (w[0], w[1], t_period, omega),
-                    y0,
-                    samples.as_deref_mut(),
-                    steps,
-                    evals,
-                )?
-            } else {
-                match samples.as_deref_mut() {
-                    None => {
-                        let sol = IVP::ode(rhs, ta, tb, y0)
-                            .method(method)
-                            .solout(LastPoint::new(tb))
-                            .solve()
-                            .map_err(|e| Error::TimeIntegration {
-                                reason: format!("{e:?}"),
-                            })?;
-                        *steps += sol.steps.accepted + sol.steps.rejected;
-                        *evals += sol.evals.function;
-                        let (t, y) = sol.last().map_err(|e| Error::TimeIntegration {
-                            reason: e.to_string(),
-                        })?;
-                        (*t, y.clone())
-                    }
-                    Some(out) => {
-                        let ns = out[0].len();
-                        let js: Vec<usize> = (0..ns)
-                            .filter(|&j| {
-                                let th = TAU * j as f64 / ns as f64;
-                                th >= w[0] && th < w[1]
-                            })
-                            .collect();
-                        let mut ts: Vec<f64> = js
-                            .iter()
-                            .map(|&j| t_period + TAU * j as f64 / ns as f64 / omega)
-                            .collect();
-                        ts.push(tb);
-                        let sol = IVP::ode(rhs, ta, tb, y0)
-                            .method(method)
-                            .t_eval(&ts)
-                            .solve()
-                            .map_err(|e| Error::TimeIntegration {
-                                reason: format!("{e:?}"),
-                            })?;
-                        for (&j, yj) in js.iter().zip(&sol.y) {
-                            for (i, row) in out.iter_mut().enumerate() {
-                                row[j] = yj[i];
-                            }
-                        }
-                        let (t, y) = sol.last().map_err(|e| Error::TimeIntegration {
-                            reason: e.to_string(),
-                        })?;
-                        (*t, y.clone())
-                    }
-                }
-            };
-            if (t_end - tb).abs() > 1e-9 * period {
-                return Err(Error::TimeIntegration {
-                    reason: format!("stopped at t = {t_end} before the segment end {tb}"),
-                });
-            }
-            *y = y_end;
-            debug_assert_eq!(y.len(), 2 * n);
-        }
-        Ok(())
-    }
-}
-
-/// Segment bounds in θ over one period: 0, every declared time jump, 2π.
-pub(crate) fn segment_bounds(model: &Model) -> Vec<f64> {
-    let mut b: Vec<f64> = model
-        .elements()
-        .iter()
-        .flat_map(|e| e.law().time_breakpoints())
-        .filter(|t| *t > 1e-12 && *t < TAU - 1e-12)
-        .collect();
-    b.push(0.0);
-    b.push(TAU);
-    b.sort_by(f64::total_cmp);
-    b.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
-    b
-}
-
-/// State scales `(q, q̇)`: `s_q` from the linear frequency-domain response to the loads (with
-/// the elements' linear parts), `s_q̇ = s_q max(k Ω, ω_max)` with the highest undamped natural
-/// frequency `ω_max` of `(M, K0)`, since time-varying and nonlinear forces ring the structure at
-/// its natural frequencies. 1 where that is zero or singular.
-fn state_scale(model: &Model, omega: f64) -> Vec<f64> {
-    let n = model.n_dofs();
-    let Ok(dense) = model.dense("time integration") else {
-        return vec![1.0; 2 * n];
-    };
-    let (m, d0, k0) = (&dense.mass, &dense.d0, &dense.k0);
-    let mut q = vec![0.0; n];
-    let mut w_max: f64 = 0.0;
-    let orders: std::collections::BTreeSet<usize> = model.loads().iter().map(|l| l.order).collect();
-    for k in orders {
-        let w = k as f64 * omega;
-        w_max = w_max.max(w);
-        let z = DMatrix::from_fn(n, n, |i, j| {
-            Complex64::new(k0[(i, j)] - w * w * m[(i, j)], w * d0[(i, j)])
-        });
-        let mut f = DVector::from_element(n, Complex64::default());
-        for l in model.loads().iter().filter(|l| l.order == k) {
-            f[l.dof] += crate::harmonic::from_cos_sin(l.cos, l.sin);
-        }
-        if let Some(x) = z.lu().solve(&f) {
-            for i in 0..n {
-                if x[i].norm().is_finite() {
-                    q[i] += x[i].norm();
-                }
-            }
-        }
-    }
-    if let Some(chol) = m.clone().cholesky() {
-        // ω² are the eigenvalues of L⁻¹ K0 L⁻ᵀ (symmetric part), M = L Lᵀ.
-        let l_inv = chol
-            .l()
-            .try_inverse()
-            .unwrap_or_else(|| DMatrix::identity(n, n));
-        let a = &l_inv * k0 * l_inv.transpose();
-        let a = (&a + a.transpose()) * 0.5;
-        let lambda = a.symmetric_eigenvalues().max();
-        if lambda.is_finite() && lambda > 0.0 {
-            w_max = w_max.max(lambda.sqrt());
-        }
-    }
-    let qmax = q.iter().cloned().fold(0.0, f64::max);
-    let qs = if qmax > 0.0 && qmax.is_finite() {
-        qmax
-    } else {
-        1.0
-    };
-    let vs = qs * if w_max > 0.0 { w_max } else { omega };
-    let mut s = vec![qs; n];
-    s.extend(std::iter::repeat_n(vs, n));
-    s
 }

@@ -3,6 +3,7 @@
 
 #![allow(dead_code)]
 
+pub mod floquet;
 pub mod time_domain;
 
 use num_complex::Complex64;

@@ -1,87 +1,21 @@
-//! The page of `hbal report`: built from the JSON documents of `solve`, `sweep` and `modes`
-//! (the shapes documented in docs/scenes.md) and the SVG plots they wrote, inlined.
+//! The periodic solution at the scene's speed: convergence, error estimate, stability, the
+//! time series and spectrum, the DOF and element tables.
 
-use super::report::Part;
+use super::{document, figure, num, percent, Inputs};
 use hbal::report::{significant, HtmlReport};
-use hbal::scene::Scene;
 use serde_json::Value;
-use std::path::Path;
-
-/// Everything the page shows.
-pub(crate) struct Inputs<'a> {
-    pub(crate) scene: &'a Scene,
-    pub(crate) scene_text: &'a str,
-    pub(crate) dir: &'a Path,
-    pub(crate) solved: &'a Part,
-    pub(crate) swept: Option<&'a Part>,
-    pub(crate) moded: &'a Part,
-}
 
 /// Most rows of the DOF table (the DOFs with the largest max |q| of a larger model).
 const MAX_DOF_ROWS: usize = 40;
 
-/// Frequency-response plots shown (of the first DOFs; every one is in `sweep/`).
-const FREQUENCY_RESPONSES: usize = 2;
-
-/// A number of a JSON document with 4 significant digits, `–` where there is none.
-fn num(v: &Value) -> String {
-    v.as_f64().map_or("–".into(), |x| significant(x, 4))
-}
-
-/// A percentage with one decimal.
-fn percent(v: &Value) -> String {
-    v.as_f64()
-        .map_or("–".into(), |x| format!("{:.1} %", 100.0 * x))
-}
-
-/// Inlines `dir/file` as a figure, or says it is missing.
-fn figure(r: &mut HtmlReport, dir: &Path, file: &str, caption: &str) {
-    match std::fs::read_to_string(dir.join(file)) {
-        Ok(svg) => {
-            if let Err(e) = r.figure(&svg, caption) {
-                r.paragraph(&e);
-            }
-        }
-        Err(_) => r.paragraph(&format!("({caption}: no plot, {file} was not written)")),
-    }
-}
-
-pub(crate) fn build(i: &Inputs) -> String {
-    let scene = i.scene;
-    let unit = scene.speed_unit;
-    let mut r = HtmlReport::new(&format!("hbal report: {}", scene.file));
-    r.paragraph(&format!(
-        "hbal {}; {} DOFs, {} elements; speeds in {unit}, orders of the reference shaft (the fundamental is order {}).",
-        env!("CARGO_PKG_VERSION"),
-        scene.model.n_dofs(),
-        scene.model.elements().len(),
-        scene.fundamental_order
-    ));
-    solve_section(&mut r, i);
-    if let Some(part) = i.swept {
-        sweep_section(&mut r, i, part);
-    }
-    modes_section(&mut r, i);
-    r.heading("Scene");
-    r.details(&format!("{} (as read)", scene.file), i.scene_text);
-    r.finish()
-}
-
-fn solve_section(r: &mut HtmlReport, i: &Inputs) {
+pub(super) fn solve_section(r: &mut HtmlReport, i: &Inputs) {
     let scene = i.scene;
     r.heading(&format!(
         "Periodic solution at {} {}",
-        super::speed_text(scene.basis.omega() / scene.omega_per_speed),
+        crate::cli::speed_text(scene.basis.omega() / scene.omega_per_speed),
         scene.speed_unit
     ));
-    let Some(doc) = &i.solved.doc else {
-        r.status(
-            false,
-            &format!(
-                "no solution: {}",
-                i.solved.error.as_deref().unwrap_or("unknown")
-            ),
-        );
+    let Some(doc) = document(r, i.solved, "solution") else {
         return;
     };
     let converged = doc["converged"].as_bool() == Some(true);
@@ -163,7 +97,7 @@ fn solve_section(r: &mut HtmlReport, i: &Inputs) {
 }
 
 fn dof_table(r: &mut HtmlReport, i: &Inputs, doc: &Value) {
-    let orders: Vec<f64> = super::excitation_orders(i.scene, &i.scene.basis)
+    let orders: Vec<f64> = crate::cli::excitation_orders(i.scene, &i.scene.basis)
         .into_iter()
         .map(|o| o.0)
         .collect();
@@ -287,141 +221,4 @@ fn element_table(r: &mut HtmlReport, doc: &Value) {
             &stages,
         );
     }
-}
-
-fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
-    let unit = i.scene.speed_unit;
-    r.heading("Run-up");
-    let Some(doc) = &part.doc else {
-        r.status(
-            false,
-            &format!("no run-up: {}", part.error.as_deref().unwrap_or("unknown")),
-        );
-        return;
-    };
-    let points = doc["points"].as_array().map_or(&[][..], Vec::as_slice);
-    let unstable = points.iter().filter(|p| p["stable"] == false).count();
-    let worst = points
-        .iter()
-        .filter_map(|p| p["error_estimate"].as_f64())
-        .fold(0.0f64, f64::max);
-    r.status(
-        doc["reached"].as_bool() == Some(true),
-        &format!(
-            "{} points from {} to {} {unit}: {}",
-            points.len(),
-            num(&doc["from"]),
-            num(&doc["to"]),
-            doc["stop"].as_str().unwrap_or("?")
-        ),
-    );
-    r.facts(&[
-        ("folds", doc["folds"].to_string()),
-        ("unstable points", unstable.to_string()),
-        ("largest error estimate", significant(worst, 2)),
-        ("time", format!("{} s", num(&doc["seconds"]))),
-    ]);
-    if let Some(losses) = doc["contact_loss"].as_array().filter(|l| !l.is_empty()) {
-        let rows: Vec<Vec<String>> = losses
-            .iter()
-            .map(|c| {
-                vec![
-                    c["element"].as_str().unwrap_or("?").to_string(),
-                    num(&c["from"]),
-                    num(&c["to"]),
-                    percent(&c["max_open"]),
-                ]
-            })
-            .collect();
-        let (from, to) = (format!("from ({unit})"), format!("to ({unit})"));
-        r.table(
-            &["contact opens", &from, &to, "largest open fraction"],
-            &rows,
-        );
-    } else {
-        r.paragraph("No contact opens along the run-up.");
-    }
-    let dir = i.dir.join("sweep");
-    figure(
-        r,
-        &dir,
-        "order_cuts.svg",
-        "Order cuts: amplitude of each excitation order against speed",
-    );
-    figure(
-        r,
-        &dir,
-        "waterfall.svg",
-        "Waterfall: the spectrum at each speed",
-    );
-    let dofs = i.scene.model.dof_names();
-    for dof in dofs.iter().take(FREQUENCY_RESPONSES) {
-        figure(
-            r,
-            &dir,
-            &format!("frequency_response_{dof}.svg"),
-            &format!("Frequency response of {dof} (stable solid, unstable dashed)"),
-        );
-    }
-    if dofs.len() > FREQUENCY_RESPONSES {
-        r.paragraph(&format!(
-            "The frequency responses of the other {} DOFs are in sweep/.",
-            dofs.len() - FREQUENCY_RESPONSES
-        ));
-    }
-}
-
-fn modes_section(r: &mut HtmlReport, i: &Inputs) {
-    let unit = i.scene.speed_unit;
-    r.heading("Natural frequencies and critical speeds");
-    let Some(doc) = &i.moded.doc else {
-        r.status(
-            false,
-            &format!(
-                "no natural frequencies: {}",
-                i.moded.error.as_deref().unwrap_or("unknown")
-            ),
-        );
-        return;
-    };
-    let modes = doc["modes"].as_array().map_or(&[][..], Vec::as_slice);
-    r.paragraph(&format!(
-        "{} modes ({} rigid-body), linearised on the periodic solution; one- and two-tooth bounds of time-varying meshes.",
-        modes.len(),
-        doc["rigid_modes"]
-    ));
-    let rows: Vec<Vec<String>> = modes
-        .iter()
-        .enumerate()
-        .take(30)
-        .map(|(k, m)| {
-            vec![
-                (k + 1).to_string(),
-                num(&m["mean_hz"]),
-                num(&m["lower_hz"]),
-                num(&m["upper_hz"]),
-            ]
-        })
-        .collect();
-    r.table(
-        &[
-            "mode",
-            "mean stiffness (Hz)",
-            "one tooth (Hz)",
-            "two teeth (Hz)",
-        ],
-        &rows,
-    );
-    let critical = doc["critical_speeds"]
-        .as_array()
-        .map_or(&[][..], Vec::as_slice);
-    if !critical.is_empty() {
-        let rows: Vec<Vec<String>> = critical
-            .iter()
-            .map(|c| vec![num(&c["speed"]), num(&c["order"]), c["mode"].to_string()])
-            .collect();
-        let speed = format!("critical speed ({unit})");
-        r.table(&[&speed, "order", "mode"], &rows);
-    }
-    figure(r, &i.dir.join("modes"), "campbell.svg", "Campbell diagram");
 }

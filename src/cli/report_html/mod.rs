@@ -1,0 +1,78 @@
+//! The page of `hbal report`: built from the JSON documents of `solve`, `sweep` and `modes`
+//! (the shapes documented in docs/scenes.md) and the SVG plots they wrote, inlined. One file
+//! per section of the page: the periodic solution, the run-up and the natural frequencies.
+
+mod natural_frequencies;
+mod run_up;
+mod solution;
+
+use super::report::Part;
+use hbal::report::{significant, HtmlReport};
+use hbal::scene::Scene;
+use serde_json::Value;
+use std::path::Path;
+
+/// Everything the page shows.
+pub(crate) struct Inputs<'a> {
+    pub(crate) scene: &'a Scene,
+    pub(crate) scene_text: &'a str,
+    pub(crate) dir: &'a Path,
+    pub(crate) solved: &'a Part,
+    pub(crate) swept: Option<&'a Part>,
+    pub(crate) moded: &'a Part,
+}
+
+/// A number of a JSON document with 4 significant digits, `–` where there is none.
+fn num(v: &Value) -> String {
+    v.as_f64().map_or("–".into(), |x| significant(x, 4))
+}
+
+/// A percentage with one decimal.
+fn percent(v: &Value) -> String {
+    v.as_f64()
+        .map_or("–".into(), |x| format!("{:.1} %", 100.0 * x))
+}
+
+/// The JSON document of `part`, or `None` after a failed status `no {what}: {error}`.
+fn document<'a>(r: &mut HtmlReport, part: &'a Part, what: &str) -> Option<&'a Value> {
+    if part.doc.is_none() {
+        r.status(
+            false,
+            &format!("no {what}: {}", part.error.as_deref().unwrap_or("unknown")),
+        );
+    }
+    part.doc.as_ref()
+}
+
+/// Inlines `dir/file` as a figure, or says it is missing.
+fn figure(r: &mut HtmlReport, dir: &Path, file: &str, caption: &str) {
+    match std::fs::read_to_string(dir.join(file)) {
+        Ok(svg) => {
+            if let Err(e) = r.figure(&svg, caption) {
+                r.paragraph(&e);
+            }
+        }
+        Err(_) => r.paragraph(&format!("({caption}: no plot, {file} was not written)")),
+    }
+}
+
+pub(crate) fn build(i: &Inputs) -> String {
+    let scene = i.scene;
+    let unit = scene.speed_unit;
+    let mut r = HtmlReport::new(&format!("hbal report: {}", scene.file));
+    r.paragraph(&format!(
+        "hbal {}; {} DOFs, {} elements; speeds in {unit}, orders of the reference shaft (the fundamental is order {}).",
+        env!("CARGO_PKG_VERSION"),
+        scene.model.n_dofs(),
+        scene.model.elements().len(),
+        scene.fundamental_order
+    ));
+    solution::solve_section(&mut r, i);
+    if let Some(part) = i.swept {
+        run_up::sweep_section(&mut r, i, part);
+    }
+    natural_frequencies::modes_section(&mut r, i);
+    r.heading("Scene");
+    r.details(&format!("{} (as read)", scene.file), i.scene_text);
+    r.finish()
+}
