@@ -189,8 +189,9 @@ pub(crate) fn basis_with(
 ) -> Result<HarmonicBasis, Failure> {
     let mut out = *basis;
     if let Some(HarmonicsArg::Count(h)) = args.harmonics {
-        let b =
-            HarmonicBasis::new(basis.omega(), h).with_context(|| format!("{file}: --harmonics"))?;
+        let b = HarmonicBasis::new(basis.omega(), h)
+            .with_context(|| format!("{file}: --harmonics"))?
+            .with_tail_correction(basis.tail_correction());
         // Keep the scene's N where it can still carry H harmonics.
         out = b.with_samples(basis.samples()).unwrap_or(b);
     }

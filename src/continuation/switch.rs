@@ -109,6 +109,7 @@ impl Continuation {
             return Ok(failed(pb.omega, "the basis does not contain the parent's"));
         }
         let parent_basis = HarmonicBasis::new(pa.omega, parent.harmonics)?
+            .with_tail_correction(basis.tail_correction())
             .with_samples(basis.samples() / ratio)?;
         // 1. Locate the branch point on the parent branch.
         let Some((q_star, o_star)) = self.locate(model, parent_basis, pa, pb, kind)? else {

@@ -115,10 +115,11 @@ impl MeshProfile {
         let n = theta.len();
         if let MeshProfile::Sampled(table) = self {
             // The AFT's own consecutive samples: one lookup, then a copy.
-            if let Some(run) = table.run(z * theta[0] + phase, z * theta[n - 1] + phase, n) {
-                for (o, i) in out[..n].iter_mut().zip(run) {
-                    *o = table.values[i];
-                }
+            if table.copy_run(
+                z * theta[0] + phase,
+                z * theta[n - 1] + phase,
+                &mut out[..n],
+            ) {
                 return;
             }
         }

@@ -67,16 +67,20 @@ impl SampledProfile {
         ((x - i).abs() <= 1e-7).then(|| (i as i64).rem_euclid(n as i64) as usize)
     }
 
-    /// The indices of `len` consecutive tabulated angles from `first` to `last`, if they are.
-    pub(super) fn run(
-        &self,
-        first: f64,
-        last: f64,
-        len: usize,
-    ) -> Option<impl Iterator<Item = usize>> {
-        let n = self.values.len();
-        let (a, b) = (self.index(first)?, self.index(last)?);
-        ((a + len - 1) % n == b).then(|| (a..a + len).map(move |i| i % n))
+    /// `out[j] = k` at `out.len()` consecutive tabulated angles from `first` to `last`, if they
+    /// are (a copy of the table, wrapping at its end); `false` otherwise.
+    pub(super) fn copy_run(&self, first: f64, last: f64, out: &mut [f64]) -> bool {
+        let (n, len) = (self.values.len(), out.len());
+        let (Some(a), Some(b)) = (self.index(first), self.index(last)) else {
+            return false;
+        };
+        if len == 0 || len > n || (a + len - 1) % n != b {
+            return false;
+        }
+        let head = len.min(n - a);
+        out[..head].copy_from_slice(&self.values[a..a + head]);
+        out[head..].copy_from_slice(&self.values[..len - head]);
+        true
     }
 
     #[inline]

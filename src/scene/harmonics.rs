@@ -4,7 +4,7 @@ use crate::solve::AutoHarmonics;
 use crate::HarmonicBasis;
 use serde::Deserialize;
 
-/// `count` = H, `samples` = N, `auto`, `tolerance`, `max` (docs/scenes.md).
+/// `count` = H, `samples` = N, `auto`, `tolerance`, `max`, `tail_correction` (docs/scenes.md).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct Harmonics {
@@ -14,6 +14,9 @@ pub(super) struct Harmonics {
     auto: bool,
     tolerance: Option<f64>,
     max: Option<usize>,
+    /// The tail correction of jumping coefficients (default on, see
+    /// [`HarmonicBasis::with_tail_correction`]).
+    tail_correction: Option<bool>,
 }
 
 /// A field path and a message.
@@ -93,8 +96,9 @@ impl Harmonics {
                 ))
             }
         };
-        let mut basis =
-            HarmonicBasis::new(omega, count).map_err(|e| fail("harmonics.count", e.to_string()))?;
+        let mut basis = HarmonicBasis::new(omega, count)
+            .map_err(|e| fail("harmonics.count", e.to_string()))?
+            .with_tail_correction(self.tail_correction.unwrap_or(true));
         if let Some(s) = self.samples {
             basis = basis
                 .with_samples(s)

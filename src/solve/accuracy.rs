@@ -44,7 +44,8 @@ pub struct ErrorEstimate {
 /// The basis with `harmonics` harmonics at the Ω and ν of `basis`, with as many samples per
 /// harmonic as it has (at least the default).
 fn scaled(basis: &HarmonicBasis, harmonics: usize) -> Result<HarmonicBasis> {
-    let b = HarmonicBasis::new(basis.omega(), harmonics)?;
+    let b =
+        HarmonicBasis::new(basis.omega(), harmonics)?.with_tail_correction(basis.tail_correction());
     let per = basis.samples() as f64 / basis.harmonics().max(1) as f64;
     let n = ((per * harmonics as f64).ceil() as usize).max(b.samples());
     b.with_samples(n)?.with_subharmonic(basis.subharmonic())

@@ -53,8 +53,10 @@ impl CoarseBlock {
     ) -> Result<Option<(Self, Vec<Complex64>)>> {
         let basis = fine.basis();
         let n = fine.layout().n;
-        let coarse =
-            HarmonicBasis::new(basis.omega(), hc)?.with_subharmonic(basis.subharmonic())?;
+        // Only its Jacobian is used: no tail correction.
+        let coarse = HarmonicBasis::new(basis.omega(), hc)?
+            .with_subharmonic(basis.subharmonic())?
+            .with_tail_correction(false);
         let hb = HarmonicBalance::with_formulation(fine.model(), coarse, fine.formulation())?;
         let mut ws = hb.workspace();
         let layout = hb.layout();
