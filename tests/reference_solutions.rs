@@ -34,14 +34,12 @@ fn two_shaft_hb_matches_reference() {
         assert!(sol.is_converged(), "H {h}: {:?}", sol.termination);
         errors.push(relative_error(sol.harmonics(), &r.harmonics, 1, 32));
     }
-    // Rectangular stiffness: the spectrum decays like k^-3 and the error falls by more than
-    // 10x for every 4x in H (measured: 2.7e-4, 1.2e-5, 7.4e-7).
+    eprintln!("errors {errors:?}");
+    // Rectangular stiffness: the spectrum decays like k^-3; the truncated balance was good to
+    // 2.7e-4, 1.2e-5, 7.4e-7, the tail correction (the coupling through the harmonics above
+    // H) makes it 7.7e-7, 2.1e-9 and 3.2e-11 (the reference's own level is about 1e-11).
     assert!(
-        errors[0] < 3e-4 && errors[1] < 2e-5 && errors[2] < 1e-6,
-        "{errors:?}"
-    );
-    assert!(
-        errors[1] < errors[0] / 10.0 && errors[2] < errors[1] / 10.0,
+        errors[0] < 1e-6 && errors[1] < 5e-9 && errors[2] < 1e-10,
         "{errors:?}"
     );
 }
