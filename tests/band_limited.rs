@@ -44,7 +44,7 @@ fn solve(
 /// Against the time-domain reference (rtol 1e-12, restarted at every jump): without the tail
 /// correction the error over harmonics 1..=32 falls like H^-3 (measured 3.0e-4, 3.5e-5, 4.4e-6
 /// at H = 32, 64, 128; the sampled profile gave 2.0e-3, 4.9e-4 (H = 128) and 1.2e-4
-/// (H = 512)); with it (the default) 1.2e-6, 3.8e-8 and 2.1e-8 (the reference's own level).
+/// (H = 512)); with it (the default) 8.7e-7, 1.1e-7 and 2.6e-8 (near the reference's own level).
 #[test]
 fn off_sample_jumps_converge_like_h_cubed() {
     let model = model();
@@ -59,8 +59,8 @@ fn off_sample_jumps_converge_like_h_cubed() {
     let error = |h, tail| relative_error(&solve(&model, h, None, tail), &td.harmonics, 1, 32);
     let corrected: Vec<f64> = [32, 64, 128].iter().map(|&h| error(h, true)).collect();
     eprintln!("with the tail correction {corrected:?}");
-    assert!(corrected[0] < 2e-6, "{corrected:?}");
-    assert!(corrected[1] < 1e-7 && corrected[2] < 1e-7, "{corrected:?}");
+    assert!(corrected[0] < 1e-6, "{corrected:?}");
+    assert!(corrected[1] < 2e-7 && corrected[2] < 5e-8, "{corrected:?}");
     let errors: Vec<f64> = [32, 64, 128].iter().map(|&h| error(h, false)).collect();
     eprintln!("errors {errors:?}");
     assert!(errors[2] < 5e-6, "{errors:?}");

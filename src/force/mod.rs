@@ -228,7 +228,8 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
     /// coefficients possibly varying in time, as a mesh stiffness): where its coefficients
     /// jump ([`ForceLaw::time_breakpoints`]), the harmonic balance corrects the coupling
     /// through the harmonics above H (see
-    /// [`HarmonicBasis::with_tail_correction`](crate::HarmonicBasis::with_tail_correction)).
+    /// [`HarmonicBasis::with_tail_correction`](crate::HarmonicBasis::with_tail_correction)),
+    /// on the copy [`ForceLaw::band_limited`] gives (a law without one is not corrected).
     /// Default: `false`.
     fn is_linear_in_state(&self) -> bool {
         false

@@ -8,8 +8,11 @@
 //! harmonics those of the copy of the law the AFT balanced (a time-varying stiffness
 //! band-limited to 2H orders, [`ForceLaw::band_limited`](crate::force::ForceLaw::band_limited)),
 //! so that its mean is the force of the static balance (a force that jumps at a contact edge
-//! converges like the sampling). The extremes of `u` are refined to the precision of its harmonics
-//! ([`Solution::extremes`]).
+//! converges like the sampling), plus, where the basis has the tail correction on and it
+//! applies, the force the harmonics above H add through the stiffness jumps
+//! ([`HarmonicBalance::tail_forces`](crate::HarmonicBalance::tail_forces); not in the
+//! extremes, which it changes by about the solution's error). The extremes of `u` are refined
+//! to the precision of its harmonics ([`Solution::extremes`]).
 
 use crate::harmonic::AftPlan;
 use crate::model::{Element, Model};
@@ -288,10 +291,16 @@ fn tail_forces(model: &Model, sol: &Solution) -> Result<Vec<(usize, Vec<Complex6
     if !candidate || !sol.basis().tail_correction() || sol.basis().harmonics() == 0 {
         return Ok(Vec::new());
     }
-    let hb = crate::HarmonicBalance::with_formulation(
-        model,
-        *sol.basis(),
-        crate::linear::Formulation::Auto,
-    )?;
+    // Either formulation gives the same receptances; the full one where `auto` cannot condense.
+    let basis = *sol.basis();
+    let hb =
+        crate::HarmonicBalance::with_formulation(model, basis, crate::linear::Formulation::Auto)
+            .or_else(|_| {
+                crate::HarmonicBalance::with_formulation(
+                    model,
+                    basis,
+                    crate::linear::Formulation::Full,
+                )
+            })?;
     Ok(hb.tail_forces(sol.harmonics()))
 }

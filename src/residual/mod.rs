@@ -224,7 +224,8 @@ impl<'m> HarmonicBalance<'m> {
 
     /// `true` if every time-varying or nonlinear law is linear in the state
     /// ([`ForceLaw::is_linear_in_state`](crate::force::ForceLaw::is_linear_in_state)): the
-    /// Jacobian `∂R/∂x` is then the same at every `x`, and Newton factors it once.
+    /// Jacobian Newton factors (without the tail correction) is then the same at every `x`,
+    /// and Newton factors it once.
     pub fn is_linear_in_state(&self) -> bool {
         self.active.iter().all(|a| {
             let law = self.model.elements()[a.index].law();

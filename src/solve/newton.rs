@@ -4,7 +4,9 @@
 //! `x ← x + α dx` with the largest `α ∈ {1, ½, ¼, ...}` that satisfies the Armijo condition
 //! `‖R(x + α dx)‖ <= (1 - 10⁻⁴ α) ‖R(x)‖`: robust on non-smooth contact, where a full step can
 //! overshoot a contact edge. Trial points are evaluated without the Jacobian; the accepted one
-//! gets it (fused with its residual) only if another step follows.
+//! gets it (fused with its residual) only if another step follows. Where every law is linear
+//! in the state the Jacobian does not depend on x: it is factored once and the later steps
+//! (which take up the tail correction the Jacobian leaves out) reuse the factors.
 
 use super::lu;
 use super::problem::HbProblem;
@@ -160,6 +162,7 @@ impl<'a, 'm> Solver<HbProblem<'a, 'm>, HbState> for NewtonSolver {
         state: HbState,
     ) -> std::result::Result<(HbState, Option<KV>), argmin::core::Error> {
         let p = problem.problem.as_ref().expect("problem present");
+        self.factored = false;
         match p.residual(&self.progress.x, &mut self.r, Some(&mut self.jac)) {
             Ok(rel) if rel.is_finite() => {
                 self.rel = rel;
