@@ -108,8 +108,10 @@ impl Continuation {
         if ratio == 0 || ratio * parent.subharmonic.max(1) != basis.subharmonic() {
             return Ok(failed(pb.omega, "the basis does not contain the parent's"));
         }
+        // The parent's own period multiple (a branch born at an earlier period doubling has 2).
         let parent_basis = HarmonicBasis::new(pa.omega, parent.harmonics)?
             .with_tail_correction(basis.tail_correction())
+            .with_subharmonic(parent.subharmonic.max(1))?
             .with_samples(basis.samples() / ratio)?;
         // 1. Locate the branch point on the parent branch.
         let Some((q_star, o_star)) = self.locate(model, parent_basis, pa, pb, kind)? else {
