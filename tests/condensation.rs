@@ -393,3 +393,35 @@ fn auto_falls_back_to_full_on_dependent_mesh_coordinates() {
     let err = HarmonicBalance::with_formulation(&model, basis, Formulation::Condensed).unwrap_err();
     assert!(err.to_string().contains("linearly dependent"), "{err}");
 }
+
+/// A singular `Z_1` at one Ω (undamped `K − Ω² M` with `Ω² = 1` an eigenvalue of
+/// `K = [[2, −1], [−1, 2]]`, `M = I`) is an error, and the condensed balance moves on to
+/// another Ω afterwards with the answer of one built there (it lost its condensation before).
+#[test]
+fn condensed_set_omega_recovers_after_a_singular_harmonic() {
+    use hbal::force::CubicSpring;
+    let model = Model::builder(&["a", "b"])
+        .mass_diagonal(&[1.0, 1.0])
+        .stiffness_triplets(&[(0, 0, 2.0), (0, 1, -1.0), (1, 0, -1.0), (1, 1, 2.0)])
+        .element("cubic", &[("a", 1.0)], CubicSpring::new(0.0, 0.1))
+        .load("a", 1, 0.2, 0.0)
+        .build()
+        .unwrap();
+    let basis = HarmonicBasis::new(0.7, 5).unwrap();
+    let mut hb = HarmonicBalance::with_formulation(&model, basis, Formulation::Condensed).unwrap();
+    assert!(hb.set_omega(1.0).is_err(), "Z_1 is singular at Ω = 1");
+    hb.set_omega(1.5).unwrap();
+    let moved = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
+    let fresh_hb = HarmonicBalance::with_formulation(
+        &model,
+        basis.with_omega(1.5).unwrap(),
+        Formulation::Condensed,
+    )
+    .unwrap();
+    let fresh = Newton::new()
+        .solve(&fresh_hb, &mut fresh_hb.workspace())
+        .unwrap();
+    assert!(moved.is_converged() && fresh.is_converged());
+    let d = relative_error(moved.harmonics(), fresh.harmonics(), 2, 5);
+    assert!(d < 1e-12, "{d:e}");
+}

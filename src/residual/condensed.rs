@@ -9,12 +9,18 @@ use num_complex::Complex64;
 
 impl HarmonicBalance<'_> {
     /// Condenses onto the element coordinates at the current basis (again after a change
-    /// of Ω): `G_k⁻¹` becomes the dynamic stiffness and the condensed load the load.
+    /// of Ω): `G_k⁻¹` becomes the dynamic stiffness and the condensed load the load. On an
+    /// error after the first condensation (a singular `Z_k` at this Ω) the condensation is kept,
+    /// so that [`HarmonicBalance::set_omega`] can move on to another Ω.
     pub(crate) fn condense(&mut self) -> Result<()> {
         let (mut cond, f_full) = match self.condensed.take() {
             Some(b) => {
                 let (mut c, f) = *b;
-                c.refactor(&self.basis)?;
+                // Kept on an error (a singular Z_k at this Ω), so that another Ω can follow.
+                if let Err(e) = c.refactor(&self.basis) {
+                    self.condensed = Some(Box::new((c, f)));
+                    return Err(e);
+                }
                 (c, f)
             }
             None => {
@@ -40,8 +46,21 @@ impl HarmonicBalance<'_> {
                 (c, std::mem::take(&mut self.f_split))
             }
         };
-        let linear = cond.linear_part(&f_full)?;
-        self.z = DynamicStiffness::from_matrices(linear.stiffness, self.basis.fundamental())?;
+        let linear = match cond.linear_part(&f_full) {
+            Ok(linear) => linear,
+            Err(e) => {
+                self.condensed = Some(Box::new((cond, f_full)));
+                return Err(e);
+            }
+        };
+        let z = match DynamicStiffness::from_matrices(linear.stiffness, self.basis.fundamental()) {
+            Ok(z) => z,
+            Err(e) => {
+                self.condensed = Some(Box::new((cond, f_full)));
+                return Err(e);
+            }
+        };
+        self.z = z;
         self.f_ext = linear.load.clone();
         self.f_split = linear.load;
         self.condensed = Some(Box::new((cond, f_full)));
