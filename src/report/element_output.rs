@@ -283,11 +283,10 @@ fn min_max(x: &[f64]) -> (f64, f64) {
 /// ([`crate::HarmonicBalance::tail_forces`]), from a harmonic balance of the same basis;
 /// none (and no discretisation) where no law can have it.
 fn tail_forces(model: &Model, sol: &Solution) -> Result<Vec<(usize, Vec<Complex64>)>> {
-    let candidate = model.elements().iter().any(|e| {
-        e.law().is_linear_in_state()
-            && e.law().memory().is_none()
-            && !e.law().time_breakpoints().is_empty()
-    });
+    let candidate = model
+        .elements()
+        .iter()
+        .any(|e| crate::residual::tail_corrects(e.law()));
     if !candidate || !sol.basis().tail_correction() || sol.basis().harmonics() == 0 {
         return Ok(Vec::new());
     }

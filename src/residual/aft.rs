@@ -14,6 +14,14 @@ use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 
+/// `w·x` over the unknowns of `weights`.
+#[inline]
+pub(super) fn gather(weights: &[(usize, f64)], x: &[Complex64]) -> Complex64 {
+    weights
+        .iter()
+        .fold(Complex64::default(), |acc, &(i, w)| acc + x[i] * w)
+}
+
 /// `out += w f` over the unknowns of `weights`.
 #[inline]
 pub(super) fn scatter_add(weights: &[(usize, f64)], f: Complex64, out: &mut [Complex64]) {
@@ -220,10 +228,7 @@ impl HarmonicBalance<'_> {
     pub(super) fn element_samples(&self, act: &ActiveElement, q: &[Complex64], b: &mut AftBuffers) {
         let (n, omega) = (self.n, self.basis.fundamental());
         for (k, uk) in b.uk.iter_mut().enumerate() {
-            *uk = act
-                .weights
-                .iter()
-                .fold(Complex64::default(), |acc, &(i, w)| acc + q[k * n + i] * w);
+            *uk = gather(&act.weights, &q[k * n..(k + 1) * n]);
         }
         self.aft
             .synthesize_into(&b.uk, |_| Complex64::new(1.0, 0.0), &mut b.u, &mut b.aft);

@@ -36,6 +36,7 @@ mod located;
 mod memory;
 mod real_form;
 mod tail;
+pub(crate) use tail::corrects as tail_corrects;
 mod workspace;
 use aft::ActiveElement;
 pub use limits::{estimate_bytes, MAX_SYSTEM_BYTES};

@@ -51,6 +51,12 @@ use crate::model::Model;
 use num_complex::Complex64;
 use std::sync::Arc;
 
+/// Whether the tail correction applies to `law`: linear in the state, without memory, with
+/// coefficients that jump in time.
+pub(crate) fn corrects(law: &dyn ForceLaw) -> bool {
+    law.is_linear_in_state() && law.memory().is_none() && !law.time_breakpoints().is_empty()
+}
+
 /// The plan, laws and receptance model of the tail correction of one [`HarmonicBalance`].
 #[derive(Debug)]
 pub(super) struct TailCorrection {
@@ -120,10 +126,7 @@ impl TailCorrection {
             .enumerate()
             .filter_map(|(i, a)| {
                 let law = hb.model.elements()[a.index].law();
-                let jumps = law.is_linear_in_state()
-                    && law.memory().is_none()
-                    && !law.time_breakpoints().is_empty();
-                if !jumps {
+                if !corrects(law) {
                     return None;
                 }
                 let law: Arc<dyn ForceLaw> = law.band_limited(samples, band)?.into();
@@ -167,10 +170,7 @@ impl TailCorrection {
             );
             hb.z.solve_in_place(h, &mut x);
             for a in 0..m {
-                let g = hb.active[self.elements[a].active]
-                    .weights
-                    .iter()
-                    .fold(Complex64::default(), |acc, &(i, w)| acc + x[i] * w);
+                let g = super::aft::gather(&hb.active[self.elements[a].active].weights, &x);
                 let mass = self.mobility[a * m + b] / s2;
                 self.mass_h[a * m + b] = mass;
                 self.rest_h[a * m + b] = g + mass;
@@ -262,9 +262,7 @@ impl TailCorrection {
             let weights = &hb.active[te.active].weights;
             tb.uk.fill(Complex64::default());
             for (k, uk) in tb.uk[..=h].iter_mut().enumerate() {
-                *uk = weights
-                    .iter()
-                    .fold(Complex64::default(), |acc, &(i, w)| acc + q[k * n + i] * w);
+                *uk = super::aft::gather(weights, &q[k * n..(k + 1) * n]);
             }
             self.plan
                 .synthesize_into(&tb.uk, |_| Complex64::new(1.0, 0.0), &mut tb.u, aft);
