@@ -7,7 +7,7 @@
 
 use hbal::continuation::{Branch, BranchPoint};
 use hbal::report::{
-    element_outputs, line_plot, waterfall_plot, Axis, ElementOutput, Series, Slice, Waterfall,
+    line_plot, waterfall_plot, Axis, ElementOutput, ElementReport, Series, Slice, Waterfall,
 };
 use hbal::scene::Scene;
 use hbal::{HarmonicBasis, Solution};
@@ -323,6 +323,7 @@ pub(crate) fn point_outputs(
     branch: &Branch,
     basis: &HarmonicBasis,
 ) -> anyhow::Result<Vec<Vec<ElementOutput>>> {
+    let mut report = ElementReport::new(&scene.model);
     branch
         .points
         .iter()
@@ -333,7 +334,7 @@ pub(crate) fn point_outputs(
                 p.harmonics.clone(),
                 p.residual,
             )?;
-            Ok(element_outputs(&scene.model, &sol)?)
+            Ok(report.outputs(&sol)?)
         })
         .collect()
 }

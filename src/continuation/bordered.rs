@@ -39,6 +39,11 @@ impl Bordered {
 
     /// Evaluates R, R_x, R_Ω at (x, Ω) and factors the bordered matrix with last row `t`.
     /// Returns the relative residual, or None if singular.
+    ///
+    /// With `stale_omega_column = Some(tol)` the last R_Ω is kept unless the relative residual
+    /// is at most `tol`: after a step at fixed Ω ([`hold_omega`]) the next one is again at
+    /// fixed Ω, and that step does not depend on the R_Ω column (`R_x δx = -R`); the
+    /// converged point's tangent gets a fresh one.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn factor(
         &mut self,
@@ -47,15 +52,23 @@ impl Bordered {
         x: &[f64],
         omega: f64,
         t: &[f64],
-        sx: f64,
-        so: f64,
-        ext: f64,
+        sc: Scales,
+        stale_omega_column: Option<f64>,
     ) -> Result<Option<f64>> {
+        let Scales { sx, so, ext } = sc;
         if (hb.basis().omega() - omega).abs() > 0.0 {
             hb.set_omega(omega)?;
         }
         hb.residual_real_into(x, &mut self.r, Some(&mut self.jac), ws)?;
-        hb.omega_derivative_real_into(x, &mut self.r_omega, ws)?;
+        let rel = self.layout.norm(&self.r) / ext;
+        if !rel.is_finite() {
+            return Err(Error::NonFinite {
+                what: "residual on the branch".into(),
+            });
+        }
+        if stale_omega_column.is_none_or(|tol| rel <= tol) {
+            hb.omega_derivative_real_into(x, &mut self.r_omega, ws)?;
+        }
         let m = self.layout.len();
         for (j, tj) in t.iter().enumerate().take(m) {
             for i in 0..m {
@@ -67,12 +80,6 @@ impl Bordered {
             self.big[(i, m)] = self.r_omega[i] * so;
         }
         self.big[(m, m)] = t[m];
-        let rel = self.layout.norm(&self.r) / ext;
-        if !rel.is_finite() {
-            return Err(Error::NonFinite {
-                what: "residual on the branch".into(),
-            });
-        }
         Ok(lu::factor_in_place(&mut self.big, &mut self.perm).then_some(rel))
     }
 
@@ -133,17 +140,8 @@ impl<'m> Tracer<'m> {
     /// Factors the bordered matrix with last row `row` at `(x, Ω)`: the relative residual, or
     /// `None` if singular.
     pub(super) fn factor(&mut self, x: &[f64], omega: f64, row: &[f64]) -> Result<Option<f64>> {
-        let sc = self.sc;
-        self.b.factor(
-            &mut self.hb,
-            &mut self.ws,
-            x,
-            omega,
-            row,
-            sc.sx,
-            sc.so,
-            sc.ext,
-        )
+        self.b
+            .factor(&mut self.hb, &mut self.ws, x, omega, row, self.sc, None)
     }
 
     /// The norm residuals are relative to: the load's (or the load of the split, or 1 without
@@ -195,11 +193,15 @@ impl Continuation {
     ) -> Option<(usize, f64)> {
         let m = x.len();
         let sc = tr.sc;
+        let mut held = false;
         for it in 0..=self.max_corrector {
             if !(*o > 0.0 && o.is_finite()) {
                 return None;
             }
-            let rel = match tr.factor(x, *o, target.row) {
+            let stale = held.then_some(self.tolerance);
+            let factored =
+                tr.b.factor(&mut tr.hb, &mut tr.ws, x, *o, target.row, sc, stale);
+            let rel = match factored {
                 Ok(Some(rel)) => rel,
                 Ok(None) | Err(_) => return None,
             };
@@ -219,9 +221,7 @@ impl Continuation {
             g += target.row[m] * (*o - target.op) / sc.so;
             b.rhs[m] = -g;
             lu::solve_in_place(&b.big, &b.perm, &mut b.rhs);
-            if it >= 1 && rel <= HOLD_OMEGA_RESIDUAL {
-                hold_omega(b);
-            }
+            held = rel <= HOLD_OMEGA_RESIDUAL && hold_omega(b);
             for i in 0..m {
                 x[i] += b.rhs[i] * sc.sx;
             }
@@ -287,29 +287,31 @@ pub(super) fn tangent(b: &mut Bordered, t: &mut [f64]) {
     }
 }
 
-/// The relative residual below which a corrector iteration after the first keeps Ω
-/// ([`hold_omega`]): close enough to the branch that Newton at fixed Ω cannot reach another
-/// branch at the same Ω (a fold's other side).
-const HOLD_OMEGA_RESIDUAL: f64 = 1e-6;
+/// The relative residual below which a corrector iteration keeps Ω ([`hold_omega`]): close
+/// enough to the branch that Newton at fixed Ω cannot reach another branch at the same Ω (a
+/// fold's other side). A predicted point on a smooth branch is usually that close, so that a
+/// point costs one new Ω (in the condensed formulation one refactorisation of every `Z_k`).
+const HOLD_OMEGA_RESIDUAL: f64 = 1e-4;
 
 /// Turns the corrector step `δ = B⁻¹ [-R; c]` in `b.rhs` into the step at fixed Ω,
 /// `R_x δx = -R`, where the branch is far from a turning point: `δ - (δ_Ω / τ_Ω) τ` with
-/// `τ = B⁻¹ [0; 1]` (the same factors), so that `δ_Ω = 0`. After the first iteration the Ω
-/// the corrector reached is kept: the next iteration then needs no new `Z_k` (in the condensed
-/// formulation a refactorisation of every harmonic). Near a turning point (`|τ_Ω|` below a
-/// quarter of `‖τ‖`) the step stays on the arclength hyperplane.
-fn hold_omega(b: &mut Bordered) {
+/// `τ = B⁻¹ [0; 1]` (the same factors), so that `δ_Ω = 0`: the iterate's Ω is kept, and the
+/// next iteration needs no new `Z_k` (in the condensed formulation a refactorisation of every
+/// harmonic). Near a turning point (`|τ_Ω|` below a quarter of `‖τ‖`) the step stays on the
+/// arclength hyperplane. Returns whether Ω was kept.
+fn hold_omega(b: &mut Bordered) -> bool {
     let m = b.layout.len();
     let mut tau = vec![0.0; m + 1];
     tau[m] = 1.0;
     lu::solve_in_place(&b.big, &b.perm, &mut tau);
     let norm = tau.iter().map(|v| v * v).sum::<f64>().sqrt();
     if !(tau[m].abs() >= 0.25 * norm && norm.is_finite()) {
-        return;
+        return false;
     }
     let c = b.rhs[m] / tau[m];
     for (d, t) in b.rhs.iter_mut().zip(&tau) {
         *d -= c * t;
     }
     b.rhs[m] = 0.0;
+    true
 }

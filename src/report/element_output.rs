@@ -14,6 +14,7 @@
 //! extremes, which it changes by about the solution's error). The extremes of `u` are refined
 //! to the precision of its harmonics ([`Solution::extremes`]).
 
+use super::ElementReport;
 use crate::harmonic::AftPlan;
 use crate::model::{Element, Model};
 use crate::solution::Solution;
@@ -104,6 +105,15 @@ pub struct ElementOutput {
 /// # Ok::<(), hbal::Error>(())
 /// ```
 pub fn element_outputs(model: &Model, sol: &Solution) -> Result<Vec<ElementOutput>> {
+    ElementReport::new(model).outputs(sol)
+}
+
+/// [`element_outputs`] with the tail correction's forces `tail` (`(element, harmonics)`).
+pub(super) fn outputs_with_tail(
+    model: &Model,
+    sol: &Solution,
+    tail: Vec<(usize, Vec<Complex64>)>,
+) -> Result<Vec<ElementOutput>> {
     let basis = sol.basis();
     let h = basis.harmonics();
     let samples = (8 * basis.samples()).clamp(4096, 1 << 16);
@@ -114,7 +124,6 @@ pub fn element_outputs(model: &Model, sol: &Solution) -> Result<Vec<ElementOutpu
     let n = model.n_dofs();
     let theta: Vec<f64> = (0..samples).map(|j| fine.shaft_angle(j)).collect();
     let (mut u, mut du, mut f) = (vec![0.0; samples], vec![0.0; samples], vec![0.0; samples]);
-    let tail = tail_forces(model, sol)?;
     let mut out = Vec::with_capacity(model.elements().len());
     for (index, e) in model.elements().iter().enumerate() {
         let coordinate: Vec<Complex64> = (0..=h)
@@ -277,29 +286,4 @@ fn min_max(x: &[f64]) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         })
-}
-
-/// The force harmonics the tail correction added to the elements it corrects
-/// ([`crate::HarmonicBalance::tail_forces`]), from a harmonic balance of the same basis;
-/// none (and no discretisation) where no law can have it.
-fn tail_forces(model: &Model, sol: &Solution) -> Result<Vec<(usize, Vec<Complex64>)>> {
-    let candidate = model
-        .elements()
-        .iter()
-        .any(|e| crate::residual::tail_corrects(e.law()));
-    if !candidate || !sol.basis().tail_correction() || sol.basis().harmonics() == 0 {
-        return Ok(Vec::new());
-    }
-    // Either formulation gives the same receptances; the full one where `auto` cannot condense.
-    let basis = *sol.basis();
-    let hb =
-        crate::HarmonicBalance::with_formulation(model, basis, crate::linear::Formulation::Auto)
-            .or_else(|_| {
-                crate::HarmonicBalance::with_formulation(
-                    model,
-                    basis,
-                    crate::linear::Formulation::Full,
-                )
-            })?;
-    Ok(hb.tail_forces(sol.harmonics()))
 }

@@ -2,6 +2,7 @@
 
 mod branch;
 mod element_output;
+mod element_report;
 mod html;
 mod modes;
 mod plot;
@@ -10,6 +11,7 @@ mod waterfall;
 
 pub use branch::{branch_csv, branch_csv_orders, branch_plot, branches_plot};
 pub use element_output::{element_outputs, ElementOutput, MeshOutput, Signal};
+pub use element_report::ElementReport;
 pub use html::{escape, HtmlReport};
 pub use modes::{natural_frequencies, NaturalFrequencies};
 pub use plot::{line_plot, significant, tick_label, Axis, Series};
