@@ -160,6 +160,7 @@ impl Continuation {
                 xp: &xp,
                 op,
                 row: &t,
+                chord: true,
             };
             let Some((iterations, mut rel)) = self.correct(tr, &mut x_new, &mut o_new, &target)
             else {
@@ -200,6 +201,7 @@ impl Continuation {
                     xp: &xl,
                     op: to,
                     row: &land_row,
+                    chord: false,
                 };
                 if let Some((_, r)) = self.correct(tr, &mut xc, &mut oc, &land) {
                     x_new.copy_from_slice(&xc);

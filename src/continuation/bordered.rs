@@ -95,6 +95,9 @@ pub(super) struct Target<'a> {
     pub(super) xp: &'a [f64],
     pub(super) op: f64,
     pub(super) row: &'a [f64],
+    /// Whether steps at fixed Ω may reuse the factors ([`Continuation::correct`]): for a
+    /// caller that needs the tangent at the result only as a predictor.
+    pub(super) chord: bool,
 }
 
 /// The scales of the unknowns: `s_x` (the RMS of the current point) and `s_Ω`.
@@ -144,6 +147,19 @@ impl<'m> Tracer<'m> {
             .factor(&mut self.hb, &mut self.ws, x, omega, row, self.sc, None)
     }
 
+    /// The relative residual at `x` (the current Ω), into the buffer `b.r`; no Jacobian.
+    pub(super) fn residual(&mut self, x: &[f64]) -> Result<f64> {
+        self.hb
+            .residual_real_into(x, &mut self.b.r, None, &mut self.ws)?;
+        let rel = self.b.layout.norm(&self.b.r) / self.sc.ext;
+        if !rel.is_finite() {
+            return Err(Error::NonFinite {
+                what: "residual on the branch".into(),
+            });
+        }
+        Ok(rel)
+    }
+
     /// The norm residuals are relative to: the load's (or the load of the split, or 1 without
     /// either).
     pub(super) fn load_norm(&self) -> f64 {
@@ -183,7 +199,13 @@ impl<'m> Tracer<'m> {
 
 impl Continuation {
     /// Newton on the bordered system towards `target`, from `(x, Ω)`; on success the number
-    /// of iterations and the relative residual (the matrix is then factored at the result).
+    /// of iterations and the relative residual. The matrix is then factored at the result, or
+    /// with [`Target::chord`] possibly at the iterate where Ω was fixed (chord steps).
+    ///
+    /// Once an iteration keeps Ω ([`hold_omega`]), the next steps are Newton steps at that
+    /// fixed Ω. With [`Target::chord`] they reuse the factors (chord steps: a residual without
+    /// the Jacobian, no factorisation) while each one reduces the residual at least
+    /// [`CHORD_RATE`]-fold, and otherwise factor the Jacobian at the iterate again.
     pub(super) fn correct(
         &self,
         tr: &mut Tracer,
@@ -193,17 +215,32 @@ impl Continuation {
     ) -> Option<(usize, f64)> {
         let m = x.len();
         let sc = tr.sc;
-        let mut held = false;
+        let (mut held, mut last) = (false, f64::INFINITY);
         for it in 0..=self.max_corrector {
             if !(*o > 0.0 && o.is_finite()) {
                 return None;
             }
-            let stale = held.then_some(self.tolerance);
-            let factored =
-                tr.b.factor(&mut tr.hb, &mut tr.ws, x, *o, target.row, sc, stale);
-            let rel = match factored {
-                Ok(Some(rel)) => rel,
-                Ok(None) | Err(_) => return None,
+            let mut rel = None;
+            if held && target.chord {
+                let chord = tr.residual(x).ok()?;
+                if chord <= self.tolerance {
+                    return Some((it, chord));
+                }
+                if chord <= CHORD_RATE * last {
+                    rel = Some(chord);
+                }
+            }
+            let rel = match rel {
+                Some(rel) => rel,
+                None => {
+                    let stale = held.then_some(self.tolerance);
+                    let factored =
+                        tr.b.factor(&mut tr.hb, &mut tr.ws, x, *o, target.row, sc, stale);
+                    match factored {
+                        Ok(Some(rel)) => rel,
+                        Ok(None) | Err(_) => return None,
+                    }
+                }
             };
             if rel <= self.tolerance {
                 return Some((it, rel));
@@ -222,6 +259,7 @@ impl Continuation {
             b.rhs[m] = -g;
             lu::solve_in_place(&b.big, &b.perm, &mut b.rhs);
             held = rel <= HOLD_OMEGA_RESIDUAL && hold_omega(b);
+            last = rel;
             for i in 0..m {
                 x[i] += b.rhs[i] * sc.sx;
             }
@@ -261,6 +299,7 @@ impl Continuation {
                 xp: &xp,
                 op,
                 row: t0,
+                chord: false,
             };
             self.correct(tr, &mut xc, &mut oc, &target)?;
             tangent(&mut tr.b, &mut tt);
@@ -292,6 +331,11 @@ pub(super) fn tangent(b: &mut Bordered, t: &mut [f64]) {
 /// fold's other side). A predicted point on a smooth branch is usually that close, so that a
 /// point costs one new Ω (in the condensed formulation one refactorisation of every `Z_k`).
 const HOLD_OMEGA_RESIDUAL: f64 = 1e-4;
+
+/// A chord step at fixed Ω is kept while it reduces the residual at least this much (the
+/// factors are from a nearby iterate, so the rate is about the relative change of the
+/// Jacobian between them); otherwise the Jacobian is factored again.
+const CHORD_RATE: f64 = 0.1;
 
 /// Turns the corrector step `δ = B⁻¹ [-R; c]` in `b.rhs` into the step at fixed Ω,
 /// `R_x δx = -R`, where the branch is far from a turning point: `δ - (δ_Ω / τ_Ω) τ` with

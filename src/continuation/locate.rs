@@ -100,6 +100,7 @@ impl Continuation {
                 xp: &xp,
                 op,
                 row: &chord,
+                chord: false,
             };
             let Some((_, rel)) = self.correct(&mut tr, &mut xc, &mut oc, &target) else {
                 return Ok(None);

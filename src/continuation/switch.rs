@@ -246,6 +246,7 @@ impl Continuation {
                 xp: &xp,
                 op,
                 row: phi,
+                chord: false,
             };
             if let Some((_, rel)) = self.correct(tr, &mut xc, &mut oc, &target) {
                 return Some((xc, oc, rel));
