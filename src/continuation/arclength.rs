@@ -2,6 +2,7 @@
 //! [`continuation`](super)): the first point, then [`Continuation::follow`] along the branch.
 
 use super::bordered::{tangent, Scales, Target, Tracer};
+use super::pipeline::{Sink, Traced, LOOKAHEAD};
 use super::point::NewPoint;
 use super::{Branch, BranchStop, Continuation};
 use crate::error::{Error, Result};
@@ -10,6 +11,8 @@ use crate::residual::HarmonicBalance;
 use crate::solve::robust_start;
 use crate::HarmonicBasis;
 use num_complex::Complex64;
+use std::sync::atomic::AtomicBool;
+use std::sync::mpsc::sync_channel;
 
 /// Where a branch is followed: it lands exactly on `to` and stops there; with `back`, also on
 /// `back` should it leave the range that way (a secondary branch may head either way, and
@@ -132,18 +135,74 @@ impl Continuation {
 
     /// Continues `branch` (its last point `(x, Ω)` with unit tangent `t` in the scaled
     /// unknowns) until it reaches `range.to`, leaves the range through `range.back`, or stops.
+    /// With the stability on and a second core, the points' stability is computed by a worker
+    /// while the next points are traced ([`pipeline`](super::pipeline)): the same branch.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn follow(
         &self,
         tr: &mut Tracer,
         model: &Model,
         branch: &mut Branch,
+        x: Vec<f64>,
+        omega: f64,
+        t: Vec<f64>,
+        range: Range,
+        progress: impl FnMut(f64),
+    ) {
+        let from = omega;
+        let stop = if self.pipelined(model) {
+            let failed = AtomicBool::new(false);
+            let (tx, rx) = sync_channel(LOOKAHEAD);
+            let len = branch.points.len();
+            let (stop, failure) = std::thread::scope(|s| {
+                let worker = s.spawn(|| self.append_all(branch, model, rx, &failed));
+                let mut sink = Sink::Worker {
+                    tx,
+                    failed: &failed,
+                    len,
+                };
+                let stop = self.trace(tr, model, &mut sink, x, omega, t, range, progress);
+                drop(sink);
+                let failure = worker
+                    .join()
+                    .unwrap_or_else(|e| std::panic::resume_unwind(e));
+                (stop, failure)
+            });
+            // A failed stability ends the branch there, whatever the tracer did after it.
+            match failure {
+                Some((omega, reason)) => Some(BranchStop::StabilityFailed { omega, reason }),
+                None => stop,
+            }
+        } else {
+            let mut sink = Sink::Direct(branch);
+            self.trace(tr, model, &mut sink, x, omega, t, range, progress)
+        };
+        if let Some(stop) = stop {
+            branch.stop = stop;
+        }
+        super::point::classify_turns(branch);
+        if branch.points.len() >= self.max_points && branch.stop == BranchStop::Reached {
+            let last = branch.points.last().map_or(from, |p| p.omega);
+            if (last - range.to) * if range.to >= from { 1.0 } else { -1.0 } < 0.0 {
+                branch.stop = BranchStop::MaxPoints;
+            }
+        }
+    }
+
+    /// The predictor–corrector loop of [`Continuation::follow`], its points into `sink`: why
+    /// it stopped, `None` at the largest number of points.
+    #[allow(clippy::too_many_arguments)]
+    fn trace(
+        &self,
+        tr: &mut Tracer,
+        model: &Model,
+        sink: &mut Sink,
         mut x: Vec<f64>,
         mut omega: f64,
         mut t: Vec<f64>,
         range: Range,
         mut progress: impl FnMut(f64),
-    ) {
+    ) -> Option<BranchStop> {
         let m = x.len();
         let (from, to) = (omega, range.to);
         let direction = if to >= from { 1.0 } else { -1.0 };
@@ -152,7 +211,7 @@ impl Continuation {
         let (mut xp, mut x_new) = (vec![0.0; m], vec![0.0; m]);
         let mut land_row = vec![0.0; m + 1];
         land_row[m] = 1.0;
-        while branch.points.len() < self.max_points {
+        while sink.len() < self.max_points {
             let op = tr.sc.predict(&x, omega, &t, step, &mut xp);
             x_new.copy_from_slice(&xp);
             let mut o_new = op;
@@ -166,8 +225,7 @@ impl Continuation {
             else {
                 step *= 0.5;
                 if step < self.min_step {
-                    branch.stop = BranchStop::StepTooSmall { omega };
-                    break;
+                    return Some(BranchStop::StepTooSmall { omega });
                 }
                 continue;
             };
@@ -236,23 +294,26 @@ impl Continuation {
             tr.sc.sx = sx_new;
             x.copy_from_slice(&x_new);
             omega = o_new;
-            let failed = self.push(branch, model, &tr.hb, &x, omega, rel);
-            if let Some(last) = branch.points.last_mut() {
-                last.fold = turn;
-                last.fold_omega = turn_omega;
-            }
+            let failed = match new_point(&tr.hb, &x, omega, rel) {
+                Ok(point) => {
+                    let traced = Traced {
+                        point,
+                        turn,
+                        turn_omega,
+                    };
+                    sink.append(self, model, traced)
+                }
+                Err(reason) => Some(reason),
+            };
             if let Some(reason) = failed {
-                branch.stop = BranchStop::StabilityFailed { omega, reason };
-                break;
+                return Some(BranchStop::StabilityFailed { omega, reason });
             }
             progress(((omega - from) / (to - from)).clamp(0.0, 1.0));
             if landed || (omega - to) * direction >= 0.0 {
-                branch.stop = BranchStop::Reached;
-                break;
+                return Some(BranchStop::Reached);
             }
             if rejoined {
-                branch.stop = BranchStop::Rejoined { omega };
-                break;
+                return Some(BranchStop::Rejoined { omega });
             }
             if iterations <= 2 {
                 step = (step * 1.5).min(self.max_step);
@@ -260,13 +321,7 @@ impl Continuation {
                 step *= 0.7;
             }
         }
-        super::point::classify_turns(branch);
-        if branch.points.len() >= self.max_points && branch.stop == BranchStop::Reached {
-            let last = branch.points.last().map_or(from, |p| p.omega);
-            if (last - to) * direction < 0.0 {
-                branch.stop = BranchStop::MaxPoints;
-            }
-        }
+        None
     }
 
     /// Appends the point `x` at `omega` (on the basis of `hb`); `Some(reason)` if its
@@ -280,31 +335,35 @@ impl Continuation {
         omega: f64,
         residual: f64,
     ) -> Option<String> {
-        let mut unknowns = vec![Complex64::default(); hb.len()];
-        hb.layout().unpack(x, &mut unknowns);
-        // All DOFs (the condensed formulation recovers them from the coordinates; `hb` sits
-        // at `omega` after the corrector).
-        let harmonics = if hb.is_condensed() {
-            match hb.full_harmonics(&unknowns, &mut hb.workspace().eval) {
-                Ok(h) => h,
-                Err(e) => return Some(e.to_string()),
-            }
-        } else {
-            unknowns
-        };
-        let basis = match hb.basis().with_omega(omega) {
-            Ok(b) => b,
-            Err(e) => return Some(e.to_string()),
-        };
-        self.push_point(
-            branch,
-            model,
-            NewPoint {
-                basis,
-                harmonics,
-                parameter: omega,
-                residual,
-            },
-        )
+        match new_point(hb, x, omega, residual) {
+            Ok(point) => self.push_point(branch, model, point),
+            Err(reason) => Some(reason),
+        }
     }
+}
+
+/// The point `x` at `omega` (on the basis of `hb`) with all DOFs' harmonics (the condensed
+/// formulation recovers them from the coordinates; `hb` sits at `omega` after the corrector).
+fn new_point(
+    hb: &HarmonicBalance,
+    x: &[f64],
+    omega: f64,
+    residual: f64,
+) -> std::result::Result<NewPoint, String> {
+    let mut unknowns = vec![Complex64::default(); hb.len()];
+    hb.layout().unpack(x, &mut unknowns);
+    let harmonics = if hb.is_condensed() {
+        hb.full_harmonics(&unknowns, &mut hb.workspace().eval)
+            .map_err(|e| e.to_string())?
+    } else {
+        unknowns
+    };
+    let basis = hb.basis().with_omega(omega).map_err(|e| e.to_string())?;
+    Ok(NewPoint {
+        basis,
+        harmonics,
+        parameter: omega,
+        residual,
+        max_abs: None,
+    })
 }

@@ -18,6 +18,7 @@ mod arclength;
 mod bordered;
 mod locate;
 mod parameter;
+mod pipeline;
 mod point;
 mod speed_homotopy;
 mod switch;
@@ -296,6 +297,11 @@ pub struct Continuation {
     /// for the element coordinates; points still carry all DOFs). Default
     /// [`Formulation::Auto`](crate::Formulation::Auto).
     pub formulation: crate::Formulation,
+    /// With [`stability`](Self::stability) on and a second core, compute the points'
+    /// stability on a worker thread while the next points are traced (the same branch as on
+    /// one thread: the worker appends the points in order and a failed stability still ends
+    /// the branch there). Default `true`.
+    pub stability_worker: bool,
 }
 
 impl Default for Continuation {
@@ -311,6 +317,7 @@ impl Default for Continuation {
             stability: Some(FloquetOptions::default()),
             error_estimate: false,
             formulation: crate::Formulation::Auto,
+            stability_worker: true,
         }
     }
 }

@@ -104,6 +104,7 @@ pub fn parameter_sweep(
             harmonics: sol.harmonics().to_vec(),
             parameter: p,
             residual: sol.residual(),
+            max_abs: None,
         };
         if let Some(reason) = cont.push_point(b, &model, point) {
             b.stop = BranchStop::StabilityFailed {

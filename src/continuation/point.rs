@@ -28,6 +28,9 @@ pub(super) struct NewPoint {
     pub harmonics: Vec<Complex64>,
     pub parameter: f64,
     pub residual: f64,
+    /// `max |q_i|` of every DOF if already known (computed by the tracer of a pipelined
+    /// sweep, which would otherwise wait for the worker).
+    pub max_abs: Option<Vec<f64>>,
 }
 
 impl Continuation {
@@ -98,7 +101,7 @@ impl Continuation {
             (Some(false), Some(true)) => prev.as_ref().and_then(|f| f.critical()),
             _ => None,
         };
-        let max_abs = sol.max_abs_all();
+        let max_abs = p.max_abs.unwrap_or_else(|| sol.max_abs_all());
         let truncation = sol.truncation_estimate();
         let error_estimate = self
             .error_estimate

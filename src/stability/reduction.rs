@@ -14,8 +14,12 @@
 //! The modes come from a [`ModeCache`], computed once per model up to a reach (by default
 //! twice the cut-off) and selected below each cut-off.
 //!
-//! The shift `σ = 10⁻⁴ ω_ref²` (`ω_ref` the cut-off, or for every mode the largest
-//! `sqrt(K0_ii / M_ii)`) makes a free-free model's singular `K0` factorisable.
+//! The shift `σ = 10⁻⁴ ω_ref²` (`ω_ref` the first mode above the cut-off where the cache knows
+//! it, else the cut-off, or for every mode the largest `sqrt(K0_ii / M_ii)`) makes a free-free
+//! model's singular `K0` factorisable. It leaves the attachment modes' components along the
+//! modes left out (weights `1/(ω_j² + σ)`, `ω_j > ω_c`) unchanged to 10⁻⁴; taken from the
+//! modes, it is the same for every cut-off between two modes, and a sweep's points share the
+//! basis until a mode crosses the cut-off.
 //!
 //! What it leaves out: the modes above `ω_c` as dynamic degrees of freedom, and so their
 //! multipliers. With structural damping they lie deep inside the unit circle
@@ -28,6 +32,7 @@ use nalgebra::{DMatrix, DVector};
 use std::hash::{Hash, Hasher};
 
 /// A reduced basis and what it holds.
+#[derive(Debug, Clone)]
 pub(crate) struct Basis {
     /// `V` (n × (r + a)), M-orthonormal.
     pub(crate) v: DMatrix<f64>,
@@ -47,6 +52,10 @@ pub(crate) struct ModeCache {
     complete: f64,
     values: Vec<f64>,
     vectors: DMatrix<f64>,
+    /// The last basis made from these modes: `(modes kept, shift, basis)`. A sweep's cut-off
+    /// moves with Ω, but the modes below it (and so the basis) change only where a mode
+    /// crosses it.
+    last: Option<(usize, f64, Basis)>,
 }
 
 impl ModeCache {
@@ -58,7 +67,7 @@ impl ModeCache {
         k0: &SparseMatrix,
         cutoff: f64,
         reach: f64,
-    ) -> Result<(Vec<f64>, DMatrix<f64>)> {
+    ) -> Result<(Vec<f64>, DMatrix<f64>, Option<f64>)> {
         let fingerprint = fingerprint(model.mass(), k0);
         if fingerprint != self.fingerprint || self.complete < cutoff * cutoff {
             let reach = reach.max(cutoff);
@@ -73,6 +82,7 @@ impl ModeCache {
             };
             self.values = modes.values;
             self.vectors = modes.vectors;
+            self.last = None;
         }
         let r = self
             .values
@@ -82,6 +92,7 @@ impl ModeCache {
         Ok((
             self.values[..r].to_vec(),
             self.vectors.columns(0, r).into_owned(),
+            self.values.get(r).copied(),
         ))
     }
 }
@@ -133,9 +144,22 @@ pub(crate) fn reduced_basis(
         ));
     }
     let k0 = model.k0();
-    let (values, vectors) = cache.below(model, &k0, cutoff, reach)?;
-    let factor = ShiftedStiffness::new(&k0, model.mass(), shift(model, &k0, cutoff))?;
+    let (values, vectors, next) = cache.below(model, &k0, cutoff, reach)?;
+    // The shift from the first mode left out where it is known (the same for every cut-off
+    // between two modes, so that the basis is too), else from the cut-off.
+    let sigma = match next {
+        Some(w2) if w2 > 0.0 && w2.is_finite() => 1e-4 * w2,
+        _ => shift(model, &k0, cutoff),
+    };
     let r = values.len();
+    if let Some((_, _, basis)) = cache
+        .last
+        .as_ref()
+        .filter(|(kept, s, _)| *kept == r && *s == sigma)
+    {
+        return Ok(basis.clone());
+    }
+    let factor = ShiftedStiffness::new(&k0, model.mass(), sigma)?;
     // Unit forces on the element coordinates and the loaded DOFs.
     let mut forces: Vec<Vec<(usize, f64)>> = model
         .elements()
@@ -180,11 +204,13 @@ pub(crate) fn reduced_basis(
         v.set_column(last, &x);
         kept += 1;
     }
-    Ok(Basis {
+    let basis = Basis {
         v,
         modes: r,
         attachment: kept,
-    })
+    };
+    cache.last = Some((r, sigma, basis.clone()));
+    Ok(basis)
 }
 
 fn m_times(model: &Model, x: &DVector<f64>) -> DVector<f64> {

@@ -1,0 +1,134 @@
+//! Where [`Continuation::follow`] puts its points: appended on the tracing thread, or, with
+//! the Floquet stability on and a second core, by a worker thread that computes each point's
+//! stability while the tracing thread already corrects the next points.
+//!
+//! The branch does not depend on the stability of its points, except that a failed stability
+//! ends it there. The worker appends the points in order, with the same [`FloquetCache`] carried
+//! from point to point, so its branch is the serial one: the points the tracer computed after
+//! a failed point are dropped, and the branch stops at the failure as it would have serially.
+//! The tracer runs at most [`LOOKAHEAD`] points ahead.
+//!
+//! [`FloquetCache`]: crate::stability::FloquetCache
+
+use super::point::NewPoint;
+use super::{Branch, Continuation};
+use crate::model::Model;
+use crate::solution::Solution;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender};
+
+/// Points the tracer may compute ahead of the worker.
+pub(super) const LOOKAHEAD: usize = 4;
+
+/// A traced point on its way to the branch, with what the tracer knows of a turn before it.
+pub(super) struct Traced {
+    pub(super) point: NewPoint,
+    pub(super) turn: bool,
+    pub(super) turn_omega: Option<f64>,
+}
+
+/// The tracer's end of the branch.
+pub(super) enum Sink<'b> {
+    /// Appends on the tracing thread.
+    Direct(&'b mut Branch),
+    /// Sends to the worker ([`Continuation::append_all`]).
+    Worker {
+        tx: SyncSender<Traced>,
+        /// Set by the worker when a point's stability failed.
+        failed: &'b AtomicBool,
+        /// Points on the branch before the first one sent, plus those sent.
+        len: usize,
+    },
+}
+
+impl Sink<'_> {
+    /// Points on the branch, counting those on their way.
+    pub(super) fn len(&self) -> usize {
+        match self {
+            Sink::Direct(branch) => branch.points.len(),
+            Sink::Worker { len, .. } => *len,
+        }
+    }
+
+    /// Appends `traced`; `Some(reason)` if the branch must end here (its stability failed; with
+    /// a worker also at a later point, once the worker reports an earlier failure).
+    pub(super) fn append(
+        &mut self,
+        continuation: &Continuation,
+        model: &Model,
+        traced: Traced,
+    ) -> Option<String> {
+        match self {
+            Sink::Direct(branch) => continuation.append(branch, model, traced),
+            Sink::Worker { tx, failed, len } => {
+                let stopped = || Some("stability failed at an earlier point".to_string());
+                if failed.load(Ordering::Acquire) {
+                    return stopped();
+                }
+                // The max |q| of every DOF here, the stability on the worker.
+                let mut traced = traced;
+                let point = &mut traced.point;
+                if let Ok(sol) = Solution::from_harmonics(
+                    point.basis,
+                    model.dof_names().to_vec(),
+                    point.harmonics.clone(),
+                    point.residual,
+                ) {
+                    point.max_abs = Some(sol.max_abs_all());
+                }
+                if tx.send(traced).is_err() {
+                    return stopped();
+                }
+                *len += 1;
+                None
+            }
+        }
+    }
+}
+
+impl Continuation {
+    /// Appends a traced point to `branch` with its stability and turn flags; `Some(reason)` if
+    /// its stability failed.
+    pub(super) fn append(
+        &self,
+        branch: &mut Branch,
+        model: &Model,
+        traced: Traced,
+    ) -> Option<String> {
+        let failed = self.push_point(branch, model, traced.point);
+        if let Some(last) = branch.points.last_mut() {
+            last.fold = traced.turn;
+            last.fold_omega = traced.turn_omega;
+        }
+        failed
+    }
+
+    /// The worker: appends every point received, in order, until the first whose stability
+    /// failed (`failed` is set then, and `(Ω, reason)` returned).
+    pub(super) fn append_all(
+        &self,
+        branch: &mut Branch,
+        model: &Model,
+        rx: Receiver<Traced>,
+        failed: &AtomicBool,
+    ) -> Option<(f64, String)> {
+        for traced in rx {
+            let omega = traced.point.basis.omega();
+            if let Some(reason) = self.append(branch, model, traced) {
+                failed.store(true, Ordering::Release);
+                return Some((omega, reason));
+            }
+        }
+        None
+    }
+
+    /// Whether a branch of `model` is followed with a worker: asked for
+    /// ([`Continuation::stability_worker`]), stability on (and computable: no law with memory)
+    /// and a second core.
+    pub(super) fn pipelined(&self, model: &Model) -> bool {
+        self.stability_worker
+            && self.stability.is_some()
+            && model.memory_element().is_none()
+            && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+    }
+}
