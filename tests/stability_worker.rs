@@ -7,12 +7,14 @@ use hbal::catalog::Duffing;
 use hbal::continuation::{Branch, BranchStop, Continuation};
 use hbal::stability::FloquetOptions;
 use hbal::HarmonicBasis;
+use std::time::Duration;
 
 fn sweep(worker: bool, stability: FloquetOptions) -> Branch {
     let model = Duffing::default().model().unwrap();
     Continuation {
         stability: Some(stability),
-        stability_worker: worker,
+        // Always (the Duffing points' stability is quick), or never.
+        stability_worker: worker.then_some(Duration::ZERO),
         ..Continuation::default()
     }
     .run(&model, HarmonicBasis::new(2.6, 7).unwrap(), 0.5, |_| {})

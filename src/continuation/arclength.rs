@@ -150,7 +150,7 @@ impl Continuation {
         progress: impl FnMut(f64),
     ) {
         let from = omega;
-        let stop = if self.pipelined(model) {
+        let stop = if self.pipelined(model, branch) {
             let failed = AtomicBool::new(false);
             let (tx, rx) = sync_channel(LOOKAHEAD);
             let len = branch.points.len();

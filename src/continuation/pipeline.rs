@@ -1,5 +1,6 @@
 //! Where [`Continuation::follow`] puts its points: appended on the tracing thread, or, with
-//! the Floquet stability on and a second core, by a worker thread that computes each point's
+//! the Floquet stability on, a second core and a stability that takes long enough
+//! ([`Continuation::stability_worker`]), by a worker thread that computes each point's
 //! stability while the tracing thread already corrects the next points.
 //!
 //! The branch does not depend on the stability of its points, except that a failed stability
@@ -122,12 +123,15 @@ impl Continuation {
         None
     }
 
-    /// Whether a branch of `model` is followed with a worker: asked for
-    /// ([`Continuation::stability_worker`]), stability on (and computable: no law with memory)
-    /// and a second core.
-    pub(super) fn pipelined(&self, model: &Model) -> bool {
-        self.stability_worker
-            && self.stability.is_some()
+    /// Whether `branch` of `model` is followed with a worker: stability on (and computable:
+    /// no law with memory), its last point's stability took at least
+    /// [`Continuation::stability_worker`], and a second core.
+    pub(super) fn pipelined(&self, model: &Model, branch: &Branch) -> bool {
+        let took = branch.stability_cache.last_time();
+        self.stability.is_some()
+            && self
+                .stability_worker
+                .is_some_and(|from| took.is_some_and(|t| t >= from))
             && model.memory_element().is_none()
             && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
     }

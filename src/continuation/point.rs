@@ -61,6 +61,7 @@ impl Continuation {
                 // The modes and the last orbit correction carry over from point to point; the
                 // reduction's estimate is computed where a label is decided: at the first
                 // point and wherever the stability changes.
+                let started = std::time::Instant::now();
                 let cache = &mut branch.stability_cache;
                 let quick = FloquetOptions {
                     estimate: false,
@@ -72,6 +73,7 @@ impl Continuation {
                     }
                     Ok(f)
                 });
+                cache.set_last_time(started.elapsed());
                 match f {
                     // A non-finite multiplier would reach the outputs as NaN or `null`: it
                     // ends the branch here, named, instead.

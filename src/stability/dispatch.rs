@@ -287,12 +287,24 @@ pub struct FloquetCache {
     corrections: Vec<(f64, Vec<f64>)>,
     jacobian: Option<KeptJacobian>,
     kappa: Option<f64>,
+    /// How long the last point's analysis took (set by the sweep that owns the cache).
+    last_time: Option<std::time::Duration>,
 }
 
 /// Orbit corrections kept for the next point's prediction (a quadratic in Ω).
 const PREDICTION_POINTS: usize = 3;
 
 impl FloquetCache {
+    /// How long the last point's analysis took, if a sweep recorded it.
+    pub(crate) fn last_time(&self) -> Option<std::time::Duration> {
+        self.last_time
+    }
+
+    /// Records how long the last point's analysis took.
+    pub(crate) fn set_last_time(&mut self, time: std::time::Duration) {
+        self.last_time = Some(time);
+    }
+
     /// The orbit correction `(δq, δq̇)` (`len` values) predicted at `omega` from the last
     /// ones if the last is within 20 %: their Lagrange polynomial through `(Ω_i, d_i)` (at most
     /// quadratic), over the last points on which the sweep goes on in the same direction by
