@@ -135,8 +135,9 @@ impl Continuation {
 
     /// Continues `branch` (its last point `(x, Ω)` with unit tangent `t` in the scaled
     /// unknowns) until it reaches `range.to`, leaves the range through `range.back`, or stops.
-    /// With the stability on and a second core, the points' stability is computed by a worker
-    /// while the next points are traced ([`pipeline`](super::pipeline)): the same branch.
+    /// With the stability on, a second core and a last point whose stability took at least
+    /// [`Continuation::stability_worker`], the points' stability is computed by a worker while
+    /// the next points are traced ([`pipeline`](super::pipeline)): the same branch.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn follow(
         &self,
@@ -147,31 +148,41 @@ impl Continuation {
         omega: f64,
         t: Vec<f64>,
         range: Range,
-        progress: impl FnMut(f64),
+        mut progress: impl FnMut(f64),
     ) {
         let from = omega;
         let stop = if self.pipelined(model, branch) {
             let failed = AtomicBool::new(false);
             let (tx, rx) = sync_channel(LOOKAHEAD);
             let len = branch.points.len();
-            let (stop, failure) = std::thread::scope(|s| {
-                let worker = s.spawn(|| self.append_all(branch, model, rx, &failed));
+            let (x0, t0) = (x.clone(), t.clone());
+            let outcome = std::thread::scope(|s| {
+                let worker = std::thread::Builder::new()
+                    .spawn_scoped(s, || self.append_all(branch, model, rx, &failed))
+                    .ok()?;
                 let mut sink = Sink::Worker {
                     tx,
                     failed: &failed,
                     len,
                 };
-                let stop = self.trace(tr, model, &mut sink, x, omega, t, range, progress);
+                let stop = self.trace(tr, model, &mut sink, x, omega, t, range, &mut progress);
                 drop(sink);
                 let failure = worker
                     .join()
                     .unwrap_or_else(|e| std::panic::resume_unwind(e));
-                (stop, failure)
+                Some((stop, failure))
             });
-            // A failed stability ends the branch there, whatever the tracer did after it.
-            match failure {
-                Some((omega, reason)) => Some(BranchStop::StabilityFailed { omega, reason }),
-                None => stop,
+            match outcome {
+                // A failed stability ends the branch there, whatever the tracer did after it.
+                Some((_, Some((omega, reason)))) => {
+                    Some(BranchStop::StabilityFailed { omega, reason })
+                }
+                Some((stop, None)) => stop,
+                // No thread to be had: on this one.
+                None => {
+                    let mut sink = Sink::Direct(branch);
+                    self.trace(tr, model, &mut sink, x0, omega, t0, range, &mut progress)
+                }
             }
         } else {
             let mut sink = Sink::Direct(branch);
@@ -229,7 +240,8 @@ impl Continuation {
                 }
                 continue;
             };
-            // Tangent at the new point (bordered matrix factored there with the old t).
+            // Tangent at the new point (the bordered matrix factored there with the old t, or
+            // after chord steps at the iterate where Ω was kept: a predictor either way).
             let t_prev = t.clone();
             tangent(&mut tr.b, &mut t);
             let turn = t_prev[m] * t[m] < 0.0;
@@ -294,6 +306,13 @@ impl Continuation {
             tr.sc.sx = sx_new;
             x.copy_from_slice(&x_new);
             omega = o_new;
+            // Locating a turn moves `hb` to other Ω: the recovery of all DOFs needs the point's.
+            if tr.hb.basis().omega() != omega {
+                if let Err(e) = tr.hb.set_omega(omega) {
+                    let reason = e.to_string();
+                    return Some(BranchStop::StabilityFailed { omega, reason });
+                }
+            }
             let failed = match new_point(&tr.hb, &x, omega, rel) {
                 Ok(point) => {
                     let traced = Traced {

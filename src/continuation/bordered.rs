@@ -39,12 +39,6 @@ impl Bordered {
 
     /// Evaluates R, R_x, R_Ω at (x, Ω) and factors the bordered matrix with last row `t`.
     /// Returns the relative residual, or None if singular.
-    ///
-    /// With `stale_omega_column = Some(tol)` the last R_Ω is kept unless the relative residual
-    /// is at most `tol`: after a step at fixed Ω ([`hold_omega`]) the next one is again at
-    /// fixed Ω, and that step does not depend on the R_Ω column (`R_x δx = -R`); the
-    /// converged point's tangent gets a fresh one.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn factor(
         &mut self,
         hb: &mut HarmonicBalance,
@@ -53,7 +47,6 @@ impl Bordered {
         omega: f64,
         t: &[f64],
         sc: Scales,
-        stale_omega_column: Option<f64>,
     ) -> Result<Option<f64>> {
         let Scales { sx, so, ext } = sc;
         if (hb.basis().omega() - omega).abs() > 0.0 {
@@ -66,9 +59,7 @@ impl Bordered {
                 what: "residual on the branch".into(),
             });
         }
-        if stale_omega_column.is_none_or(|tol| rel <= tol) {
-            hb.omega_derivative_real_into(x, &mut self.r_omega, ws)?;
-        }
+        hb.omega_derivative_real_into(x, &mut self.r_omega, ws)?;
         let m = self.layout.len();
         for (j, tj) in t.iter().enumerate().take(m) {
             for i in 0..m {
@@ -95,7 +86,8 @@ pub(super) struct Target<'a> {
     pub(super) xp: &'a [f64],
     pub(super) op: f64,
     pub(super) row: &'a [f64],
-    /// Whether steps at fixed Ω may reuse the factors ([`Continuation::correct`]): for a
+    /// Whether this is a sweep's step: Ω is kept from the first iterate near the branch on,
+    /// and the steps at fixed Ω may reuse the factors ([`Continuation::correct`]), for a
     /// caller that needs the tangent at the result only as a predictor.
     pub(super) chord: bool,
 }
@@ -144,7 +136,7 @@ impl<'m> Tracer<'m> {
     /// `None` if singular.
     pub(super) fn factor(&mut self, x: &[f64], omega: f64, row: &[f64]) -> Result<Option<f64>> {
         self.b
-            .factor(&mut self.hb, &mut self.ws, x, omega, row, self.sc, None)
+            .factor(&mut self.hb, &mut self.ws, x, omega, row, self.sc)
     }
 
     /// The relative residual at `x` (the current Ω), into the buffer `b.r`; no Jacobian.
@@ -233,9 +225,7 @@ impl Continuation {
             let rel = match rel {
                 Some(rel) => rel,
                 None => {
-                    let stale = held.then_some(self.tolerance);
-                    let factored =
-                        tr.b.factor(&mut tr.hb, &mut tr.ws, x, *o, target.row, sc, stale);
+                    let factored = tr.b.factor(&mut tr.hb, &mut tr.ws, x, *o, target.row, sc);
                     match factored {
                         Ok(Some(rel)) => rel,
                         Ok(None) | Err(_) => return None,
@@ -258,7 +248,14 @@ impl Continuation {
             g += target.row[m] * (*o - target.op) / sc.so;
             b.rhs[m] = -g;
             lu::solve_in_place(&b.big, &b.perm, &mut b.rhs);
-            held = rel <= HOLD_OMEGA_RESIDUAL && hold_omega(b);
+            // The sweep's steps keep Ω as soon as the iterate is near the branch; the others
+            // (branch switching, turning points, the landing) after a first full step.
+            let near = if target.chord {
+                rel <= HOLD_OMEGA_RESIDUAL
+            } else {
+                it >= 1 && rel <= HOLD_OMEGA_RESIDUAL_LATE
+            };
+            held = near && hold_omega(b);
             last = rel;
             for i in 0..m {
                 x[i] += b.rhs[i] * sc.sx;
@@ -326,16 +323,22 @@ pub(super) fn tangent(b: &mut Bordered, t: &mut [f64]) {
     }
 }
 
-/// The relative residual below which a corrector iteration keeps Ω ([`hold_omega`]): close
-/// enough to the branch that Newton at fixed Ω cannot reach another branch at the same Ω (a
-/// fold's other side). A predicted point on a smooth branch is usually that close, so that a
+/// The relative residual below which a sweep's corrector iteration keeps Ω ([`hold_omega`]):
+/// close enough to the branch that Newton at fixed Ω cannot reach another branch at the same Ω
+/// (a fold's other side). A predicted point on a smooth branch is usually that close, so that a
 /// point costs one new Ω (in the condensed formulation one refactorisation of every `Z_k`).
 const HOLD_OMEGA_RESIDUAL: f64 = 1e-4;
 
+/// The same for the other correctors, from their second iteration on (a branch switch's first
+/// iterate must stay on its hyperplane, off the parent branch).
+const HOLD_OMEGA_RESIDUAL_LATE: f64 = 1e-6;
+
 /// A chord step at fixed Ω is kept while it reduces the residual at least this much (the
 /// factors are from a nearby iterate, so the rate is about the relative change of the
-/// Jacobian between them); otherwise the Jacobian is factored again.
-const CHORD_RATE: f64 = 0.1;
+/// Jacobian between them); otherwise the Jacobian is factored again. At this rate a point
+/// needs at most 3 chord steps from the hold (1e-4) to the tolerance (1e-10), so that the step
+/// control, which counts iterations, sees about Newton's count.
+const CHORD_RATE: f64 = 1e-2;
 
 /// Turns the corrector step `δ = B⁻¹ [-R; c]` in `b.rhs` into the step at fixed Ω,
 /// `R_x δx = -R`, where the branch is far from a turning point: `δ - (δ_Ω / τ_Ω) τ` with

@@ -302,11 +302,13 @@ pub struct Continuation {
     /// [`Formulation::Auto`](crate::Formulation::Auto).
     pub formulation: crate::Formulation,
     /// With [`stability`](Self::stability) on and a second core, compute the points'
-    /// stability on a worker thread while the next points are traced, once a point's stability
-    /// took at least this long (`None`: never). The branch is the same as on one thread: the
-    /// worker appends the points in order, and a failed stability still ends the branch
-    /// there. Default 200 µs (below, handing points over costs about what it saves: the
-    /// Duffing sweep's 50 µs per point were 6 % slower with a worker).
+    /// stability on a worker thread while the next points are traced, if the stability of the
+    /// point the branch is followed from took at least this long (`None`: never; the first
+    /// point's time includes the modes of a reduced analysis and the reduction's estimate).
+    /// The branch is the same as on one thread: the worker appends the points in order, and a
+    /// failed stability still ends the branch there; the progress callback runs up to a few
+    /// points ahead. Default 200 µs (below, handing points over costs about what it saves:
+    /// the Duffing sweep's 50 µs per point were 6 % slower with a worker).
     pub stability_worker: Option<std::time::Duration>,
 }
 

@@ -179,8 +179,11 @@ impl Continuation {
             _ => &[1, -1],
         };
         let step = tr.distance(&xb, pb.omega, &xa, pa.omega);
+        // Each side starts from the branch point's scales (following a side rescales `tr`).
+        let scales = tr.sc;
         let mut out = Vec::new();
         for &side in sides {
+            tr.sc = scales;
             let mut branch = Branch::new(model, basis, format!("{kind:?} switch"));
             branch.origin = Some(Origin {
                 bifurcation: kind,

@@ -52,10 +52,11 @@ pub(crate) struct ModeCache {
     complete: f64,
     values: Vec<f64>,
     vectors: DMatrix<f64>,
-    /// The last basis made from these modes: `(modes kept, shift, basis)`. A sweep's cut-off
+    /// The last basis made from these modes, with a hash of what else it depends on (the
+    /// modes kept, the shift, the unit forces of the elements and loads). A sweep's cut-off
     /// moves with Ω, but the modes below it (and so the basis) change only where a mode
     /// crosses it.
-    last: Option<(usize, f64, Basis)>,
+    last: Option<(u64, Basis)>,
 }
 
 impl ModeCache {
@@ -152,14 +153,6 @@ pub(crate) fn reduced_basis(
         _ => shift(model, &k0, cutoff),
     };
     let r = values.len();
-    if let Some((_, _, basis)) = cache
-        .last
-        .as_ref()
-        .filter(|(kept, s, _)| *kept == r && *s == sigma)
-    {
-        return Ok(basis.clone());
-    }
-    let factor = ShiftedStiffness::new(&k0, model.mass(), sigma)?;
     // Unit forces on the element coordinates and the loaded DOFs.
     let mut forces: Vec<Vec<(usize, f64)>> = model
         .elements()
@@ -171,6 +164,22 @@ pub(crate) fn reduced_basis(
     loaded.sort_unstable();
     loaded.dedup();
     forces.extend(loaded.into_iter().map(|d| vec![(d, 1.0)]));
+    // The basis is that of the last call if the modes, the shift and the forces are.
+    let key = {
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (r, sigma.to_bits()).hash(&mut h);
+        for f in &forces {
+            f.len().hash(&mut h);
+            for &(i, w) in f {
+                (i, w.to_bits()).hash(&mut h);
+            }
+        }
+        h.finish()
+    };
+    if let Some((_, basis)) = cache.last.as_ref().filter(|(k, _)| *k == key) {
+        return Ok(basis.clone());
+    }
+    let factor = ShiftedStiffness::new(&k0, model.mass(), sigma)?;
     let mut a = DMatrix::zeros(n, forces.len());
     for (c, f) in forces.iter().enumerate() {
         for &(i, w) in f {
@@ -209,7 +218,7 @@ pub(crate) fn reduced_basis(
         modes: r,
         attachment: kept,
     };
-    cache.last = Some((r, sigma, basis.clone()));
+    cache.last = Some((key, basis.clone()));
     Ok(basis)
 }
 
@@ -221,4 +230,51 @@ fn m_times(model: &Model, x: &DVector<f64>) -> DVector<f64> {
 
 fn m_norm(model: &Model, x: &DVector<f64>) -> f64 {
     x.dot(&m_times(model, x)).max(0.0).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::force::CubicSpring;
+
+    /// A chain of 10 unit masses and springs, grounded at both ends, with a cubic spring between DOFs `a`
+    /// and `a + 1` (no linear part: `K0` is the chain's whatever `a`) and a load on DOF 9.
+    fn chain(a: usize) -> Model {
+        let n = 10;
+        let names: Vec<String> = (0..n).map(|i| format!("x{i}")).collect();
+        let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+        // Springs to the ground at both ends and between neighbours.
+        let k = DMatrix::from_fn(n, n, |i, j| match i.abs_diff(j) {
+            0 => 2.0,
+            1 => -1.0,
+            _ => 0.0,
+        });
+        Model::builder(&refs)
+            .mass_diagonal(&vec![1.0; n])
+            .stiffness(k)
+            .element(
+                "spring",
+                &[(refs[a], 1.0), (refs[a + 1], -1.0)],
+                CubicSpring::new(0.0, 1.0),
+            )
+            .load(refs[n - 1], 1, 1.0, 0.0)
+            .build()
+            .unwrap()
+    }
+
+    /// The kept basis is another model's only if the modes, the shift and the elements' and
+    /// loads' unit forces agree: two models with the same M and K0 and the spring elsewhere
+    /// get their own attachment modes from one cache.
+    #[test]
+    fn kept_basis_follows_the_elements() {
+        let (a, b) = (chain(2), chain(6));
+        let mut shared = ModeCache::default();
+        let first = reduced_basis(&a, 1.0, 2.0, &mut shared).unwrap();
+        let again = reduced_basis(&a, 1.0, 2.0, &mut shared).unwrap();
+        assert_eq!(first.v, again.v);
+        let kept = reduced_basis(&b, 1.0, 2.0, &mut shared).unwrap();
+        let fresh = reduced_basis(&b, 1.0, 2.0, &mut ModeCache::default()).unwrap();
+        assert_eq!(kept.v, fresh.v);
+        assert!((&first.v - &fresh.v).abs().max() > 1e-3);
+    }
 }
