@@ -9,12 +9,12 @@
 //!
 //! with the exact AFT Jacobian `R_x` and the analytic `R_Ω`
 //! ([`HarmonicBalance::omega_derivative_real_into`](crate::HarmonicBalance::omega_derivative_real_into)).
-//! Where the branch runs along Ω and the iterate is within 1e-4 of it, the corrector keeps Ω
-//! and its further steps reuse the factors (chord steps at fixed Ω, while each cuts the residual
-//! tenfold): a point then costs one new Ω (in the condensed formulation one refactorisation of
-//! every `Z_k`) and one Jacobian. The new tangent solves the same matrix with right-hand side
-//! `(0, 1)`, which keeps its orientation. A turning point (fold) lies where
-//! the Ω-component of the tangent changes sign. The step grows by 1.5 after quick corrector
+//! Where the branch runs along Ω and the iterate is within 1e-4 of it, the sweep's corrector
+//! keeps Ω and its further steps reuse the factors (chord steps at fixed Ω, while each cuts
+//! the residual a hundredfold): a point then costs one new Ω (in the condensed formulation one
+//! refactorisation of every `Z_k`) and one Jacobian. The new tangent solves the same matrix
+//! with right-hand side `(0, 1)`, which keeps its orientation. A turning point (fold) lies
+//! where the Ω-component of the tangent changes sign. The step grows by 1.5 after quick corrector
 //! convergence, shrinks by 0.5 after a failure, and the branch stops with a reason (and all
 //! points so far) when it falls under its minimum.
 
