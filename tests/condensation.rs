@@ -425,3 +425,60 @@ fn condensed_set_omega_recovers_after_a_singular_harmonic() {
     let d = relative_error(moved.harmonics(), fresh.harmonics(), 2, 5);
     assert!(d < 1e-12, "{d:e}");
 }
+
+/// A condensed sweep through the folds of a hardening three-mass chain (a cubic spring at the
+/// first mass): every point, the ones right after a located turn too, is the full formulation's
+/// solution at its Ω (locating a turn moves the condensation to other Ω; the point's DOFs are
+/// recovered at its own).
+#[test]
+fn condensed_points_after_a_turn_are_solutions_at_their_speed() {
+    let stiffness =
+        DMatrix::from_row_slice(3, 3, &[2.0, -1.0, 0.0, -1.0, 2.0, -1.0, 0.0, -1.0, 1.0]);
+    let model = Model::builder(&["x1", "x2", "x3"])
+        .mass_diagonal(&[1.0, 1.0, 1.0])
+        .damping(&stiffness * 0.02)
+        .stiffness(stiffness)
+        .element(
+            "cubic",
+            &[("x1", 1.0)],
+            hbal::force::CubicSpring::new(0.0, 1.0),
+        )
+        .load("x1", 1, 0.05, 0.0)
+        .build()
+        .unwrap();
+    let basis = HarmonicBasis::new(0.3, 5).unwrap();
+    let branch = hbal::continuation::Continuation {
+        formulation: Formulation::Condensed,
+        stability: None,
+        max_step: 0.2,
+        ..Default::default()
+    }
+    .run(&model, basis, 0.8, |_| {})
+    .unwrap();
+    assert!(branch.stop.is_normal_end(), "{}", branch.stop);
+    let turns = branch
+        .points
+        .iter()
+        .filter(|p| p.fold_omega.is_some())
+        .count();
+    assert!(turns >= 2, "{turns} turns");
+    for p in &branch.points {
+        let hb = HarmonicBalance::with_formulation(
+            &model,
+            basis.with_omega(p.omega).unwrap(),
+            Formulation::Full,
+        )
+        .unwrap();
+        let sol = Newton::new()
+            .with_tolerance(1e-13)
+            .unwrap()
+            .solve_from(&hb, &p.harmonics, &mut hb.workspace())
+            .unwrap();
+        let d = relative_error(&p.harmonics, sol.harmonics(), 3, 5);
+        assert!(
+            d < 1e-8,
+            "point at Ω = {}: {d:.1e} from the full solution",
+            p.omega
+        );
+    }
+}
