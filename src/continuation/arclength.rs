@@ -11,7 +11,6 @@ use crate::residual::HarmonicBalance;
 use crate::solve::robust_start;
 use crate::HarmonicBasis;
 use num_complex::Complex64;
-use std::sync::atomic::AtomicBool;
 use std::sync::mpsc::sync_channel;
 
 /// Where a branch is followed: it lands exactly on `to` and stops there; with `back`, also on
@@ -152,19 +151,14 @@ impl Continuation {
     ) {
         let from = omega;
         let stop = if self.pipelined(model, branch) {
-            let failed = AtomicBool::new(false);
             let (tx, rx) = sync_channel(LOOKAHEAD);
             let len = branch.points.len();
             let (x0, t0) = (x.clone(), t.clone());
             let outcome = std::thread::scope(|s| {
                 let worker = std::thread::Builder::new()
-                    .spawn_scoped(s, || self.append_all(branch, model, rx, &failed))
+                    .spawn_scoped(s, || self.append_all(branch, model, rx))
                     .ok()?;
-                let mut sink = Sink::Worker {
-                    tx,
-                    failed: &failed,
-                    len,
-                };
+                let mut sink = Sink::Worker { tx, len };
                 let stop = self.trace(tr, model, &mut sink, x, omega, t, range, &mut progress);
                 drop(sink);
                 let failure = worker
@@ -313,7 +307,7 @@ impl Continuation {
                     return Some(BranchStop::StabilityFailed { omega, reason });
                 }
             }
-            let failed = match new_point(&tr.hb, &x, omega, rel) {
+            let failed = match new_point(model, &tr.hb, &x, omega, rel) {
                 Ok(point) => {
                     let traced = Traced {
                         point,
@@ -354,7 +348,7 @@ impl Continuation {
         omega: f64,
         residual: f64,
     ) -> Option<String> {
-        match new_point(hb, x, omega, residual) {
+        match new_point(model, hb, x, omega, residual) {
             Ok(point) => self.push_point(branch, model, point),
             Err(reason) => Some(reason),
         }
@@ -364,6 +358,7 @@ impl Continuation {
 /// The point `x` at `omega` (on the basis of `hb`) with all DOFs' harmonics (the condensed
 /// formulation recovers them from the coordinates; `hb` sits at `omega` after the corrector).
 fn new_point(
+    model: &Model,
     hb: &HarmonicBalance,
     x: &[f64],
     omega: f64,
@@ -378,11 +373,5 @@ fn new_point(
         unknowns
     };
     let basis = hb.basis().with_omega(omega).map_err(|e| e.to_string())?;
-    Ok(NewPoint {
-        basis,
-        harmonics,
-        parameter: omega,
-        residual,
-        max_abs: None,
-    })
+    NewPoint::new(model, basis, harmonics, omega, residual)
 }

@@ -53,12 +53,7 @@ impl Bordered {
             hb.set_omega(omega)?;
         }
         hb.residual_real_into(x, &mut self.r, Some(&mut self.jac), ws)?;
-        let rel = self.layout.norm(&self.r) / ext;
-        if !rel.is_finite() {
-            return Err(Error::NonFinite {
-                what: "residual on the branch".into(),
-            });
-        }
+        let rel = self.relative_residual(ext)?;
         hb.omega_derivative_real_into(x, &mut self.r_omega, ws)?;
         let m = self.layout.len();
         for (j, tj) in t.iter().enumerate().take(m) {
@@ -72,6 +67,17 @@ impl Bordered {
         }
         self.big[(m, m)] = t[m];
         Ok(lu::factor_in_place(&mut self.big, &mut self.perm).then_some(rel))
+    }
+
+    /// `‖R‖ / ext` of the residual in `r`; an error if it is not finite.
+    fn relative_residual(&self, ext: f64) -> Result<f64> {
+        let rel = self.layout.norm(&self.r) / ext;
+        if !rel.is_finite() {
+            return Err(Error::NonFinite {
+                what: "residual on the branch".into(),
+            });
+        }
+        Ok(rel)
     }
 
     /// Solves the factored bordered system in place (`rhs` in, solution out).
@@ -143,13 +149,7 @@ impl<'m> Tracer<'m> {
     pub(super) fn residual(&mut self, x: &[f64]) -> Result<f64> {
         self.hb
             .residual_real_into(x, &mut self.b.r, None, &mut self.ws)?;
-        let rel = self.b.layout.norm(&self.b.r) / self.sc.ext;
-        if !rel.is_finite() {
-            return Err(Error::NonFinite {
-                what: "residual on the branch".into(),
-            });
-        }
-        Ok(rel)
+        self.b.relative_residual(self.sc.ext)
     }
 
     /// The norm residuals are relative to: the load's (or the load of the split, or 1 without

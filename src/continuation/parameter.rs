@@ -99,14 +99,12 @@ pub fn parameter_sweep(
             break;
         }
         previous = Some(sol.harmonics().to_vec());
-        let point = NewPoint {
-            basis,
-            harmonics: sol.harmonics().to_vec(),
-            parameter: p,
-            residual: sol.residual(),
-            max_abs: None,
+        let point = NewPoint::new(&model, basis, sol.harmonics().to_vec(), p, sol.residual());
+        let failed = match point {
+            Ok(point) => cont.push_point(b, &model, point),
+            Err(reason) => Some(reason),
         };
-        if let Some(reason) = cont.push_point(b, &model, point) {
+        if let Some(reason) = failed {
             b.stop = BranchStop::StabilityFailed {
                 omega: basis.omega(),
                 reason,

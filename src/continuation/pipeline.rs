@@ -14,8 +14,6 @@
 use super::point::NewPoint;
 use super::{Branch, Continuation};
 use crate::model::Model;
-use crate::solution::Solution;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender};
 
 /// Points the tracer may compute ahead of the worker.
@@ -32,11 +30,9 @@ pub(super) struct Traced {
 pub(super) enum Sink<'b> {
     /// Appends on the tracing thread.
     Direct(&'b mut Branch),
-    /// Sends to the worker ([`Continuation::append_all`]).
+    /// Sends to the worker ([`Continuation::append_all`]), which hangs up at a failed point.
     Worker {
         tx: SyncSender<Traced>,
-        /// Set by the worker when a point's stability failed.
-        failed: &'b AtomicBool,
         /// Points on the branch before the first one sent, plus those sent.
         len: usize,
     },
@@ -61,24 +57,12 @@ impl Sink<'_> {
     ) -> Option<String> {
         match self {
             Sink::Direct(branch) => continuation.append(branch, model, traced),
-            Sink::Worker { tx, failed, len } => {
-                let stopped = || Some("stability failed at an earlier point".to_string());
-                if failed.load(Ordering::Acquire) {
-                    return stopped();
-                }
+            Sink::Worker { tx, len } => {
                 // The max |q| of every DOF here, the stability on the worker.
                 let mut traced = traced;
-                let point = &mut traced.point;
-                if let Ok(sol) = Solution::from_harmonics(
-                    point.basis,
-                    model.dof_names().to_vec(),
-                    point.harmonics.clone(),
-                    point.residual,
-                ) {
-                    point.max_abs = Some(sol.max_abs_all());
-                }
+                traced.point.max_abs = Some(traced.point.solution.max_abs_all());
                 if tx.send(traced).is_err() {
-                    return stopped();
+                    return Some("stability failed at an earlier point".to_string());
                 }
                 *len += 1;
                 None
@@ -105,18 +89,16 @@ impl Continuation {
     }
 
     /// The worker: appends every point received, in order, until the first whose stability
-    /// failed (`failed` is set then, and `(Ω, reason)` returned).
+    /// failed (`(Ω, reason)` returned; dropping `rx` then tells the tracer).
     pub(super) fn append_all(
         &self,
         branch: &mut Branch,
         model: &Model,
         rx: Receiver<Traced>,
-        failed: &AtomicBool,
     ) -> Option<(f64, String)> {
         for traced in rx {
-            let omega = traced.point.basis.omega();
+            let omega = traced.point.solution.basis().omega();
             if let Some(reason) = self.append(branch, model, traced) {
-                failed.store(true, Ordering::Release);
                 return Some((omega, reason));
             }
         }

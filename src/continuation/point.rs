@@ -24,13 +24,33 @@ use num_complex::Complex64;
 
 /// What the caller knows about a new point.
 pub(super) struct NewPoint {
-    pub basis: HarmonicBasis,
-    pub harmonics: Vec<Complex64>,
+    /// The periodic solution (all DOFs) at the point's Ω.
+    pub solution: Solution,
     pub parameter: f64,
-    pub residual: f64,
     /// `max |q_i|` of every DOF if already known (computed by the tracer of a pipelined
     /// sweep, which would otherwise wait for the worker).
     pub max_abs: Option<Vec<f64>>,
+}
+
+impl NewPoint {
+    /// The point of `parameter` with the harmonics `harmonics` (all DOFs of `model`) on
+    /// `basis`, its relative residual `residual`.
+    pub(super) fn new(
+        model: &Model,
+        basis: HarmonicBasis,
+        harmonics: Vec<Complex64>,
+        parameter: f64,
+        residual: f64,
+    ) -> Result<Self, String> {
+        let solution =
+            Solution::from_harmonics(basis, model.dof_names().to_vec(), harmonics, residual)
+                .map_err(|e| e.to_string())?;
+        Ok(Self {
+            solution,
+            parameter,
+            max_abs: None,
+        })
+    }
 }
 
 impl Continuation {
@@ -42,16 +62,8 @@ impl Continuation {
         model: &Model,
         p: NewPoint,
     ) -> Option<String> {
-        let omega = p.basis.omega();
-        let sol = match Solution::from_harmonics(
-            p.basis,
-            model.dof_names().to_vec(),
-            p.harmonics,
-            p.residual,
-        ) {
-            Ok(s) => s,
-            Err(e) => return Some(e.to_string()),
-        };
+        let sol = p.solution;
+        let omega = sol.basis().omega();
         let prev = branch.points.last().and_then(|q| q.floquet.clone());
         let prev_stable = prev.as_ref().map(|f| f.is_stable());
         let (floquet, failure) = match &self.stability {
@@ -111,12 +123,13 @@ impl Continuation {
             .flatten()
             .map(|e| e.relative)
             .filter(|e| e.is_finite());
+        let residual = sol.residual();
         branch.points.push(BranchPoint {
             parameter: p.parameter,
-            omega,
             harmonics: sol.harmonics,
+            omega,
             max_abs,
-            residual: p.residual,
+            residual,
             truncation,
             error_estimate,
             floquet,

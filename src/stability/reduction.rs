@@ -60,15 +60,16 @@ pub(crate) struct ModeCache {
 }
 
 impl ModeCache {
-    /// The modes with `ω <= cutoff` of `model` (`k0` its `K0`), computing every mode up to
-    /// `reach >= cutoff` if they are not known yet; `shift` is the factorisation's shift then.
+    /// How many modes of `model` (`k0` its `K0`) have `ω <= cutoff` (the first that many of
+    /// `vectors`) and `ω²` of the next one if known, computing every mode up to
+    /// `reach >= cutoff` if they are not known yet.
     fn below(
         &mut self,
         model: &Model,
         k0: &SparseMatrix,
         cutoff: f64,
         reach: f64,
-    ) -> Result<(Vec<f64>, DMatrix<f64>, Option<f64>)> {
+    ) -> Result<(usize, Option<f64>)> {
         let fingerprint = fingerprint(model.mass(), k0);
         if fingerprint != self.fingerprint || self.complete < cutoff * cutoff {
             let reach = reach.max(cutoff);
@@ -90,11 +91,7 @@ impl ModeCache {
             .iter()
             .filter(|&&v| v <= cutoff * cutoff)
             .count();
-        Ok((
-            self.values[..r].to_vec(),
-            self.vectors.columns(0, r).into_owned(),
-            self.values.get(r).copied(),
-        ))
+        Ok((r, self.values.get(r).copied()))
     }
 }
 
@@ -145,14 +142,13 @@ pub(crate) fn reduced_basis(
         ));
     }
     let k0 = model.k0();
-    let (values, vectors, next) = cache.below(model, &k0, cutoff, reach)?;
+    let (r, next) = cache.below(model, &k0, cutoff, reach)?;
     // The shift from the first mode left out where it is known (the same for every cut-off
     // between two modes, so that the basis is too), else from the cut-off.
     let sigma = match next {
         Some(w2) if w2 > 0.0 && w2.is_finite() => 1e-4 * w2,
         _ => shift(model, &k0, cutoff),
     };
-    let r = values.len();
     // Unit forces on the element coordinates and the loaded DOFs.
     let mut forces: Vec<Vec<(usize, f64)>> = model
         .elements()
@@ -187,7 +183,7 @@ pub(crate) fn reduced_basis(
         }
     }
     factor.solve_in_place(&mut a);
-    let mut v = vectors;
+    let mut v = cache.vectors.columns(0, r).into_owned();
     let mut kept = 0;
     for c in 0..a.ncols() {
         if v.ncols() >= n {
@@ -237,8 +233,9 @@ mod tests {
     use super::*;
     use crate::force::CubicSpring;
 
-    /// A chain of 10 unit masses and springs, grounded at both ends, with a cubic spring between DOFs `a`
-    /// and `a + 1` (no linear part: `K0` is the chain's whatever `a`) and a load on DOF 9.
+    /// A chain of 10 unit masses and springs, grounded at both ends, with a cubic spring
+    /// between DOFs `a` and `a + 1` (no linear part: `K0` is the chain's whatever `a`) and a
+    /// load on DOF 9.
     fn chain(a: usize) -> Model {
         let n = 10;
         let names: Vec<String> = (0..n).map(|i| format!("x{i}")).collect();
