@@ -63,7 +63,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ))
     };
     let (wall_hb, cpu_hb, all_hb, plain) = run(None)?;
-    let (wall, cpu, all, branch) = run(Some(FloquetOptions::default()))?;
+    let options = FloquetOptions {
+        cutoff: flag(&args, "--cutoff", FloquetOptions::default().cutoff),
+        ..FloquetOptions::default()
+    };
+    let (wall, cpu, all, branch) = run(Some(options))?;
     let points = branch.points.len();
     if std::env::var("DUMP").is_ok() {
         dump(&branch);
@@ -124,6 +128,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cpu - cpu_hb,
         points,
     );
+    if let Some(r) = branch
+        .points
+        .first()
+        .and_then(|p| p.floquet.as_ref())
+        .and_then(|f| f.reduction.as_ref())
+    {
+        println!(
+            "\nreduced basis at the first point: {} coordinates ({} modes below {:.0} rad/s, {} attachment), multipliers to about {:.1e} (against {} coordinates)",
+            r.dofs,
+            r.modes,
+            r.cutoff,
+            r.attachment,
+            r.estimate.unwrap_or(f64::NAN),
+            r.comparison_dofs.unwrap_or(0)
+        );
+    }
     let mean = steps.iter().sum::<usize>() as f64 / steps.len().max(1) as f64;
     println!(
         "\nintegration steps per point: first {first:.0}, mean {mean:.0} ({:.2} of the first), \
