@@ -46,8 +46,8 @@ pub struct Reduction {
     pub dofs: usize,
     /// r, undamped modes kept (every mode below the cut-off).
     pub modes: usize,
-    /// a, attachment modes (static responses to unit forces on the element coordinates and
-    /// loaded DOFs, less those already in the span).
+    /// a, attachment modes (static responses to unit forces on the element coordinates, less
+    /// those already in the span).
     pub attachment: usize,
     /// The cut-off ω_c in rad/s.
     pub cutoff: f64,

@@ -39,8 +39,7 @@
 //! **Large models.** The dense `Φ` costs `O(n³)` per step. From
 //! [`FloquetMethod::REDUCED_FROM`] DOFs on (or with [`FloquetMethod::Reduced`]) the same
 //! shooting runs on the Galerkin projection onto `V` = the undamped modes of `(K0, M)` below
-//! `ω_c = cutoff · H Ω/ν` plus the static attachment modes of the element coordinates and
-//! loaded DOFs (sparse Cholesky of `K0 + σM`, shift-invert subspace iteration), with the
+//! `ω_c = cutoff · H Ω/ν` plus the static attachment modes of the element coordinates (sparse Cholesky of `K0 + σM`, shift-invert subspace iteration), with the
 //! model's own force laws on `u_e = (Vᵀw_e)·p`; [`Floquet::reduction`] records the basis and
 //! an accuracy estimate against the basis with twice the cut-off. With every mode kept the
 //! projection is a similarity transform and gives the dense multipliers.
@@ -127,6 +126,8 @@ pub struct Floquet {
     /// `max_i |x₀,i - x₀*,i| / s_i`: how far the shooting moved the HB state at `t = 0` to reach
     /// the exact periodic orbit, relative to the state scales (`s_q` the largest `|q|`, `s_v`
     /// the same times the fastest frequency). An independent error estimate of the HB orbit.
+    /// On a reduced basis ([`Floquet::reduction`]) measured from the HB state's projection
+    /// onto the basis, so the part of the state the basis cannot hold does not count.
     #[serde(default)]
     pub orbit_correction: f64,
     /// `true` if Newton shooting converged; otherwise the multipliers are those along the

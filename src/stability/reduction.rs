@@ -2,14 +2,23 @@
 //! attachment modes (Craig–Bampton style residual flexibility), M-orthonormal.
 //!
 //! `V = [Φ_r  A]`, with `Φ_r` the modes of `K0 φ = ω² M φ` with `ω <= ω_c` (the cut-off) and
-//! `A = (K0 + σM)⁻¹ [w_e … e_l …]` the static responses to a unit force on every time-varying
-//! or nonlinear element coordinate `u_e = w_eᵀq` and on every loaded DOF `l`. The modes carry
-//! the dynamics up to `ω_c`; the attachment modes make the element coordinates' and loads'
-//! static flexibility exact, so the contact states and the mean wind-up of the reduced orbit
-//! are those of the full model, and the truncated modes enter quasi-statically. Attachment
-//! vectors are M-orthogonalised against the modes and each other (twice, Gram–Schmidt) and
-//! dropped when they lie in the span already (relative M-norm below 1e-8): with every mode
-//! kept, `V` is square and invertible, and the reduction a similarity transform.
+//! `A = (K0 + σM)⁻¹ [w_e …]` the static responses to a unit force on every time-varying or
+//! nonlinear element coordinate `u_e = w_eᵀq`. The modes carry the dynamics up to `ω_c`; the
+//! attachment modes make the element coordinates' static flexibility exact, so the contact
+//! states and the mean wind-up of the reduced orbit are those of the full model, and the
+//! truncated modes enter quasi-statically. Attachment vectors are M-orthogonalised against the
+//! modes and each other (twice, Gram–Schmidt) and dropped when they lie in the span already
+//! (relative M-norm below 1e-8): with every mode kept, `V` is square and invertible, and the
+//! reduction a similarity transform.
+//!
+//! **No attachment modes for the loads.** The loads do not enter the variational equation,
+//! and the orbit acts on it only through the element coordinates. Those see a static load `f`
+//! exactly without a load attachment mode (Maxwell's reciprocity): the Galerkin solution
+//! `q_r ∈ span V` of `K q = f` is `K`-orthogonal to the error, and `K⁻¹ w_e ∈ span V`, so
+//! `w_eᵀ q_r = (K⁻¹w_e)ᵀ K q_r = (K⁻¹w_e)ᵀ f = w_eᵀ K⁻¹ f` (up to the shift σ). On the
+//! drivetrain (8 loaded DOFs) leaving them out takes the basis from 17 to 13 coordinates and
+//! the stability's work per point down by 30 %; the leading multipliers moved by at most
+//! 4e-5, towards those on the basis with four times the cut-off.
 //!
 //! The modes come from a [`ModeCache`], computed once per model up to a reach (by default
 //! twice the cut-off) and selected below each cut-off.
@@ -53,7 +62,7 @@ pub(crate) struct ModeCache {
     values: Vec<f64>,
     vectors: DMatrix<f64>,
     /// The last basis made from these modes, with a hash of what else it depends on (the
-    /// modes kept, the shift, the unit forces of the elements and loads). A sweep's cut-off
+    /// modes kept, the shift, the unit forces of the elements). A sweep's cut-off
     /// moves with Ω, but the modes below it (and so the basis) change only where a mode
     /// crosses it.
     last: Option<(u64, Basis)>,
@@ -149,17 +158,13 @@ pub(crate) fn reduced_basis(
         Some(w2) if w2 > 0.0 && w2.is_finite() => 1e-4 * w2,
         _ => shift(model, &k0, cutoff),
     };
-    // Unit forces on the element coordinates and the loaded DOFs.
-    let mut forces: Vec<Vec<(usize, f64)>> = model
+    // Unit forces on the element coordinates (the loads need none: see the module's docs).
+    let forces: Vec<Vec<(usize, f64)>> = model
         .elements()
         .iter()
         .filter(|e| !e.law().is_linear_time_invariant())
         .map(|e| e.weights().to_vec())
         .collect();
-    let mut loaded: Vec<usize> = model.loads().iter().map(|l| l.dof).collect();
-    loaded.sort_unstable();
-    loaded.dedup();
-    forces.extend(loaded.into_iter().map(|d| vec![(d, 1.0)]));
     // The basis is that of the last call if the modes, the shift and the forces are.
     let key = {
         let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -259,8 +264,8 @@ mod tests {
             .unwrap()
     }
 
-    /// The kept basis is another model's only if the modes, the shift and the elements' and
-    /// loads' unit forces agree: two models with the same M and K0 and the spring elsewhere
+    /// The kept basis is another model's only if the modes, the shift and the elements' unit
+    /// forces agree: two models with the same M and K0 and the spring elsewhere
     /// get their own attachment modes from one cache.
     #[test]
     fn kept_basis_follows_the_elements() {
@@ -273,5 +278,37 @@ mod tests {
         let fresh = reduced_basis(&b, 1.0, 2.0, &mut ModeCache::default()).unwrap();
         assert_eq!(kept.v, fresh.v);
         assert!((&first.v - &fresh.v).abs().max() > 1e-3);
+    }
+
+    /// No attachment mode for a load, yet the element coordinate sees it exactly
+    /// (reciprocity, module docs): the Galerkin solution of `K0 q = f` on the basis of three
+    /// modes and the element's attachment mode gives the full model's `w_eᵀq` for a load at
+    /// the far end of the chain to 6e-5 (the shift σ = 1e-4 ω₄²); the three modes alone are
+    /// 93 % off.
+    #[test]
+    fn element_coordinates_see_a_static_load_without_its_attachment_mode() {
+        let model = chain(2);
+        let basis = reduced_basis(&model, 1.0, 2.0, &mut ModeCache::default()).unwrap();
+        assert_eq!((basis.modes, basis.attachment), (3, 1));
+        let k = model.k0().to_dense();
+        let f = DVector::from_fn(10, |i, _| if i == 9 { 1.0 } else { 0.0 });
+        let w = DVector::from_fn(10, |i, _| match i {
+            2 => 1.0,
+            3 => -1.0,
+            _ => 0.0,
+        });
+        let exact = w.dot(&k.clone().lu().solve(&f).unwrap());
+        let galerkin = |v: DMatrix<f64>| {
+            let p = (v.transpose() * &k * &v)
+                .lu()
+                .solve(&(v.transpose() * &f))
+                .unwrap();
+            w.dot(&(v * p))
+        };
+        let reduced = galerkin(basis.v.clone());
+        let modes = galerkin(basis.v.columns(0, basis.modes).into_owned());
+        let relative = |a: f64| (a - exact).abs() / exact.abs();
+        assert!(relative(reduced) < 1e-4, "{}", relative(reduced));
+        assert!(relative(modes) > 0.5, "{}", relative(modes));
     }
 }

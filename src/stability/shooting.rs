@@ -175,8 +175,18 @@ pub(crate) fn shoot(
             full_scale_q * omega_max
         }
     };
+    // On a reduced basis, from the HB state's projection onto it: how far the shooting
+    // moved, not what the basis cannot hold (the reduction's own error is its estimate's).
+    let hb_here = if sys.basis.is_none() {
+        x_hb.clone()
+    } else {
+        lift(
+            sys.project(&DMatrix::from_column_slice(n_model, 2, &x_hb))
+                .as_slice(),
+        )
+    };
     let orbit_correction = (0..2 * n_model)
-        .map(|i| (orbit_start[i] - x_hb[i]).abs() / full_scale(i))
+        .map(|i| (orbit_start[i] - hb_here[i]).abs() / full_scale(i))
         .fold(0.0, f64::max);
     let multipliers = multipliers_of(&phi);
     if multipliers
