@@ -185,7 +185,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                     }
                 }
                 let s = State::new(a, offset, &self.forcing, self.delta0, &mut self.work);
-                if let Some(link) = &self.link {
+                if let Some(link) = &mut self.link {
                     link.send(Message::Generator(s.core.clone()));
                 }
                 self.states.push(s);

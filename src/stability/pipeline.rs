@@ -27,7 +27,8 @@ pub(crate) enum Message {
     Generator(Arc<Core>),
     /// A pass begins: `Φ̃ = I`.
     Begin(usize),
-    Step(Step),
+    /// The pass's next steps, in order.
+    Steps(Vec<Step>),
     /// The pass ends: `Φ̃` goes back.
     End,
 }
@@ -42,17 +43,40 @@ pub(crate) struct Link {
     pass: usize,
     /// The last `Φ̃` received, with its pass (asked for again, it is not waited for again).
     received: Option<(usize, Result<DMatrix<f64>>)>,
+    /// Steps not sent yet: they go in batches of [`BATCH`], so that the assembler is not woken
+    /// for every piece (one wake-up per step cost more than the step).
+    pending: Vec<Step>,
 }
 
+/// Steps per message.
+const BATCH: usize = 64;
+
 impl Link {
-    /// Sends `message` (a finished assembler is only possible after a panic, which the scope
-    /// reports).
-    pub(crate) fn send(&self, message: Message) {
+    /// Sends `message` after the steps before it (a finished assembler is only possible after
+    /// a panic, which the scope reports).
+    pub(crate) fn send(&mut self, message: Message) {
+        self.flush();
         let _ = self.to.send(message);
     }
 
-    /// A new pass; the last one's `Φ̃` is no longer wanted.
+    /// Queues the pass's next step.
+    pub(crate) fn step(&mut self, step: Step) {
+        self.pending.push(step);
+        if self.pending.len() >= BATCH {
+            self.flush();
+        }
+    }
+
+    fn flush(&mut self) {
+        if !self.pending.is_empty() {
+            let steps = std::mem::replace(&mut self.pending, Vec::with_capacity(BATCH));
+            let _ = self.to.send(Message::Steps(steps));
+        }
+    }
+
+    /// A new pass; the last one's `Φ̃` is no longer wanted (nor its unsent steps).
     pub(crate) fn begin(&mut self) {
+        self.pending.clear();
         self.abandoned.store(self.pass, Ordering::Relaxed);
         self.pass += 1;
         self.send(Message::Begin(self.pass));
@@ -94,9 +118,12 @@ impl Assembler {
                     pass = p;
                     self.begin();
                 }
-                Message::Step(step) => {
-                    if abandoned.load(Ordering::Relaxed) < pass {
-                        self.apply(&step);
+                Message::Steps(steps) => {
+                    for step in &steps {
+                        if abandoned.load(Ordering::Relaxed) >= pass {
+                            break;
+                        }
+                        self.apply(step);
                     }
                 }
                 Message::End => {
@@ -140,6 +167,7 @@ impl<'c, 'm> Integration<'c, 'm> {
             abandoned,
             pass: 0,
             received: None,
+            pending: Vec::with_capacity(BATCH),
         });
         std::thread::scope(|scope| {
             let handle = scope.spawn(move || assembler.serve(messages, replies, shared));

@@ -119,9 +119,9 @@ impl Assembler {
 
 impl ExpFlow<'_, '_> {
     /// Appends `step` to `record` (and sends it to a linked assembler).
-    pub(super) fn emit(&self, record: &mut Vec<Step>, step: Step) {
-        if let Some(link) = &self.link {
-            link.send(Message::Step(step));
+    pub(super) fn emit(&mut self, record: &mut Vec<Step>, step: Step) {
+        if let Some(link) = &mut self.link {
+            link.step(step);
         }
         record.push(step);
     }
@@ -135,7 +135,7 @@ impl ExpFlow<'_, '_> {
 
     /// The pass has ended.
     pub(crate) fn end_pass(&mut self) {
-        if let Some(link) = &self.link {
+        if let Some(link) = &mut self.link {
             link.send(Message::End);
         }
     }
