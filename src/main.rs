@@ -101,6 +101,11 @@ enum Command {
         /// Largest continuation step (scaled arclength; smaller gives more points).
         #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
         max_step: f64,
+        /// The DOFs whose harmonics (branch.csv, JSON) and response plots are written:
+        /// comma-separated names, or `all` (default: every DOF up to 64, else the DOFs that
+        /// elements and loads act on; max |q| of every DOF is always written).
+        #[arg(long, value_name = "NAMES")]
+        dofs: Option<String>,
         /// Sweep this numeric scene field instead of the speed, e.g. `elements[0].alpha` or
         /// `loads[1].cos` (a warm-started sweep that does not follow folds).
         #[arg(long)]
@@ -263,6 +268,7 @@ fn main() -> ExitCode {
             parameter,
             points,
             output,
+            dofs,
         } => match parameter {
             Some(_) if output.is_some() => Err(cli::Failure::from(anyhow::anyhow!(
                 "--output chooses the order-cut plot of a speed sweep; it does not apply to --parameter sweeps"
@@ -282,6 +288,7 @@ fn main() -> ExitCode {
                     stability: !no_stability,
                     json,
                     out: out.as_deref(),
+                    dofs: dofs.as_deref(),
                 },
             ),
             None => cli::sweep::sweep(
@@ -300,6 +307,7 @@ fn main() -> ExitCode {
                     error_estimate: !no_error_estimate,
                     output: output.as_deref(),
                     capture: None,
+                    dofs: dofs.as_deref(),
                 },
             ),
         },

@@ -24,6 +24,7 @@ macro_rules! say {
 
 pub(crate) mod check;
 pub(crate) mod compare;
+pub(crate) mod dof_selection;
 pub(crate) mod element_report;
 pub(crate) mod modes;
 pub(crate) mod order_cuts;

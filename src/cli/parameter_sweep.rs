@@ -20,6 +20,8 @@ pub(crate) struct ParameterSweep<'a> {
     pub(crate) stability: bool,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
+    /// `--dofs` ([`super::dof_selection`]).
+    pub(crate) dofs: Option<&'a str>,
 }
 
 pub(crate) fn parameter_sweep(
@@ -58,6 +60,7 @@ pub(crate) fn parameter_sweep(
         .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
     let probe = Scene::from_value(probe, &file)?;
     basis_with(&probe.basis, opts.solver, &file)?;
+    let reported = super::dof_selection::reported_dofs(&probe.model, opts.dofs)?;
     if let Some(dir) = out {
         for dof in probe.model.dof_names() {
             super::file_name_part(dof, "DOF")?;
@@ -141,10 +144,17 @@ pub(crate) fn parameter_sweep(
         std::fs::create_dir_all(dir)?;
         std::fs::write(
             dir.join("branch.csv"),
-            hbal::report::branch_csv_orders(&branch, probe.fundamental_order, name, |p| p),
+            hbal::report::branch_csv_orders(
+                &branch,
+                probe.fundamental_order,
+                &reported,
+                name,
+                |p| p,
+            ),
         )?;
         if branch.points.len() >= 2 {
-            for (i, dof) in branch.dofs.iter().enumerate() {
+            for &i in &reported {
+                let dof = &branch.dofs[i];
                 hbal::report::branch_plot(
                     &dir.join(format!("parameter_response_{dof}.svg")),
                     &branch,

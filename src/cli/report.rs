@@ -103,6 +103,7 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
                     error_estimate: true,
                     output: opts.output,
                     capture: Some(doc),
+                    dofs: None,
                 },
             )
         })

@@ -31,6 +31,8 @@ pub(crate) struct SweepOptions<'a> {
     pub(crate) output: Option<&'a str>,
     /// Keep the JSON document here instead of printing anything (for `hbal report`).
     pub(crate) capture: super::Capture<'a>,
+    /// `--dofs`: the DOFs whose harmonics and plots are written ([`super::dof_selection`]).
+    pub(crate) dofs: Option<&'a str>,
 }
 
 /// The branch from `basis.omega()` to `to`, from the orbit `initial` if given.
@@ -50,6 +52,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     let (to, out, max_step) = (opts.to, opts.out, opts.max_step);
     let scene = load(path, args)?;
     let shown = super::order_cuts::choose(&scene, opts.output)?;
+    let reported = super::dof_selection::reported_dofs(&scene.model, opts.dofs)?;
     if let Some(dir) = out {
         for dof in scene.model.dof_names() {
             super::file_name_part(dof, "DOF")?;
@@ -186,7 +189,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         let points: Vec<_> = branch
             .points
             .iter()
-            .map(|p| point_json(p, &branch, scene.fundamental_order, speed))
+            .map(|p| point_json(p, &branch, &reported, scene.fundamental_order, speed))
             .collect();
         super::emit(
             json!({
@@ -203,7 +206,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 "spurious_turns": branch.spurious_turns(),
                 "seconds": seconds,
                 "dofs": branch.dofs,
-                "branches": secondary.iter().map(|b| secondary_json(b, scene.fundamental_order, speed)).collect::<Vec<_>>(),
+                "harmonics_dofs": reported.iter().map(|&i| &branch.dofs[i]).collect::<Vec<_>>(),
+                "branches": secondary.iter().map(|b| secondary_json(b, &reported, scene.fundamental_order, speed)).collect::<Vec<_>>(),
                 "contact_loss": contact_loss,
             }),
             opts.capture,
@@ -239,6 +243,9 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 "  stability unknown: not available for laws with memory (element `{}`)",
                 e.name()
             );
+        }
+        if let Some(note) = out.and(super::dof_selection::note(&scene.model, &reported)) {
+            say!("  {note}");
         }
         for c in &contact_loss {
             say!(
@@ -291,18 +298,25 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         std::fs::create_dir_all(dir)?;
         std::fs::write(
             dir.join("branch.csv"),
-            hbal::report::branch_csv_orders(&branch, scene.fundamental_order, unit, speed),
+            hbal::report::branch_csv_orders(
+                &branch,
+                scene.fundamental_order,
+                &reported,
+                unit,
+                speed,
+            ),
         )?;
         super::order_cuts::write(dir, &scene, &branch, &basis, &outputs, shown, speed)?;
         for (i, b) in secondary.iter().enumerate() {
             std::fs::write(
                 dir.join(format!("branch_{}.csv", i + 1)),
-                hbal::report::branch_csv_orders(b, scene.fundamental_order, unit, speed),
+                hbal::report::branch_csv_orders(b, scene.fundamental_order, &reported, unit, speed),
             )?;
         }
         if branch.points.len() >= 2 {
             let all: Vec<&Branch> = std::iter::once(&branch).chain(&secondary).collect();
-            for (i, dof) in branch.dofs.iter().enumerate() {
+            for &i in &reported {
+                let dof = &branch.dofs[i];
                 hbal::report::branches_plot(
                     &dir.join(format!("frequency_response_{dof}.svg")),
                     &all,

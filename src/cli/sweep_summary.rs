@@ -8,10 +8,12 @@ use serde_json::json;
 
 /// One point of a branch as JSON; harmonic k of a branch with period multiple ν is order
 /// `k · fundamental_order / ν` of the reference shaft (`shaft_order`; `order` is kept as it
-/// was: k, or k/ν on a period-multiplied branch).
+/// was: k, or k/ν on a period-multiplied branch). The harmonics of the DOFs `reported` only
+/// (the document's `harmonics_dofs`).
 pub(crate) fn point_json(
     p: &BranchPoint,
     branch: &Branch,
+    reported: &[usize],
     fundamental_order: f64,
     speed: impl Fn(f64) -> f64,
 ) -> serde_json::Value {
@@ -36,7 +38,7 @@ pub(crate) fn point_json(
         "neutral": f.map(|f| f.neutral),
         "orbit_correction": f.map(|f| f.orbit_correction),
         "polished": f.map(|f| f.polished),
-        "harmonics": (0..n).map(|i| (0..=branch.harmonics).map(|k| {
+        "harmonics": reported.iter().filter(|&&i| i < n).map(|&i| (0..=branch.harmonics).map(|k| {
             let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
             let shaft_order = super::element_report::order_of(k, fundamental_order, nu);
             if nu == 1 {
@@ -52,6 +54,7 @@ pub(crate) fn point_json(
 /// points and why it ended.
 pub(crate) fn secondary_json(
     b: &Branch,
+    reported: &[usize],
     fundamental_order: f64,
     speed: impl Fn(f64) -> f64 + Copy,
 ) -> serde_json::Value {
@@ -66,7 +69,7 @@ pub(crate) fn secondary_json(
         "stop": b.stop.to_string(),
         "reached": b.stop.is_normal_end(),
         "folds": b.folds(),
-        "points": b.points.iter().map(|p| point_json(p, b, fundamental_order, speed)).collect::<Vec<_>>(),
+        "points": b.points.iter().map(|p| point_json(p, b, reported, fundamental_order, speed)).collect::<Vec<_>>(),
     })
 }
 

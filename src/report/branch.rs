@@ -16,14 +16,16 @@ use std::path::Path;
 /// the harmonic k and its order o = k/ν of the fundamental (ν the branch's period multiple);
 /// [`branch_csv_orders`] states the fundamental's order of a reference shaft.
 pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
-    branch_csv_orders(branch, 1.0, parameter_name, parameter)
+    let every: Vec<usize> = (0..branch.dofs.len()).collect();
+    branch_csv_orders(branch, 1.0, &every, parameter_name, parameter)
 }
 
 /// [`branch_csv`] with harmonic k named as order `k · fundamental_order / ν` of the reference
-/// shaft.
+/// shaft, and the amplitudes of the DOFs `amplitudes` only (indices; `max|q|` of every DOF).
 pub fn branch_csv_orders(
     branch: &Branch,
     fundamental_order: f64,
+    amplitudes: &[usize],
     parameter_name: &str,
     parameter: impl Fn(f64) -> f64,
 ) -> String {
@@ -33,7 +35,7 @@ pub fn branch_csv_orders(
         .map(|s| s.to_string())
         .collect();
     header.extend(branch.dofs.iter().map(|d| format!("max_abs_{d}")));
-    for d in &branch.dofs {
+    for d in amplitudes.iter().filter_map(|&i| branch.dofs.get(i)) {
         header.extend(
             (0..=branch.harmonics)
                 .map(|k| format!("amp_{d}_k{k}_order_{}", k as f64 * fundamental_order / nu)),
@@ -69,7 +71,7 @@ pub fn branch_csv_orders(
             p.bifurcation.map(|b| format!("{b:?}")).unwrap_or_default(),
         ];
         row.extend(p.max_abs.iter().map(|m| format!("{m:e}")));
-        for i in 0..n {
+        for &i in amplitudes.iter().filter(|&&i| i < n) {
             row.extend(
                 (0..=branch.harmonics).map(|k| format!("{:e}", p.harmonics[k * n + i].norm())),
             );

@@ -76,7 +76,7 @@ pub(crate) struct ExpFlow<'c, 'm> {
     pub(crate) steps: usize,
     /// The monodromy side, here or (linked) on another thread.
     pub(super) assembler: Box<Assembler>,
-    pub(super) link: Option<Link>,
+    pub(super) link: Option<Box<Link>>,
 }
 
 /// A piece: its generator and the laws' coefficients `(f0_e, k_e, d_e)`.

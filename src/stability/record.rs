@@ -174,10 +174,10 @@ impl ExpFlow<'_, '_> {
 
     /// Sends the generators and steps from now on to the assembler at the other end of `link`.
     pub(crate) fn link(&mut self, link: Link) {
-        self.link = Some(link);
+        self.link = Some(Box::new(link));
     }
 
-    pub(crate) fn unlink(&mut self) -> Option<Link> {
+    pub(crate) fn unlink(&mut self) -> Option<Box<Link>> {
         self.link.take()
     }
 }
