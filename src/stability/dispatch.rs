@@ -4,6 +4,7 @@
 //! reduction's accuracy estimate.
 
 use super::chord::KeptJacobian;
+use super::kept::KeptGenerators;
 use super::reduction::{reduced_basis, ModeCache};
 use super::shooting::{distance, hb_start, shoot, Goal, Shot, Start};
 use super::system::Coordinates;
@@ -163,6 +164,7 @@ impl FloquetOptions {
                 Start::Corrected(&d),
                 Goal::Exact,
                 jacobian,
+                &mut cache.generators,
             )?;
             if s.floquet.polished && s.floquet.orbit_correction <= PREDICTED_ORBIT_DISTANCE {
                 shot = Some(s);
@@ -172,7 +174,15 @@ impl FloquetOptions {
         // stands for, whatever the earlier points were.
         let shot = match shot {
             Some(s) => s,
-            None => shoot(&sys, solution, self, Start::Hb, Goal::Exact, None)?,
+            None => shoot(
+                &sys,
+                solution,
+                self,
+                Start::Hb,
+                Goal::Exact,
+                None,
+                &mut cache.generators,
+            )?,
         };
         let Shot {
             mut floquet, kappa, ..
@@ -267,7 +277,16 @@ impl FloquetOptions {
         };
         let sys = Coordinates::reduced(model, larger.v);
         let start = Start::State(&floquet.orbit_start);
-        let reference = shoot(&sys, solution, self, start, goal, None)?.floquet;
+        let reference = shoot(
+            &sys,
+            solution,
+            self,
+            start,
+            goal,
+            None,
+            &mut KeptGenerators::default(),
+        )?
+        .floquet;
         info.estimate = Some(distance(&floquet.multipliers, &reference.multipliers));
         floquet.steps += reference.steps;
         Ok(())
@@ -283,6 +302,8 @@ impl FloquetOptions {
 #[derive(Debug, Clone, Default)]
 pub struct FloquetCache {
     modes: ModeCache,
+    /// The exponential flow's generators of the last point.
+    generators: KeptGenerators,
     /// The last orbit corrections `(Ω, (δq, δq̇))`, oldest first.
     corrections: Vec<(f64, Vec<f64>)>,
     jacobian: Option<KeptJacobian>,

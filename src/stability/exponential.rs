@@ -33,8 +33,9 @@
 //! law that is not affine after all), the flow reports it and the analysis falls back on the
 //! Runge–Kutta flow.
 
-use super::expm::ExpWork;
-use super::generator::{Expansion, Forcing, State};
+use super::expm::{norm1, ExpWork};
+use super::generator::{Core, Expansion, Forcing, State};
+use super::kept::{Cores, KeptGenerators};
 use super::kernels::gemv_sum;
 use super::kinks::Kinked;
 use super::pieces::Pieces;
@@ -67,6 +68,8 @@ pub(crate) struct ExpFlow<'c, 'm> {
     work: ExpWork,
     /// The generators met so far, and their index by the laws' coefficients.
     pub(super) states: Vec<State>,
+    /// Their cores, kept from the last analysis or formed here.
+    cores: Cores,
     index: HashMap<Vec<u64>, usize>,
     /// The Taylor series of the exact solution from the last expansion point.
     pub(super) taylor: Expansion,
@@ -87,14 +90,12 @@ struct Piece {
 
 impl<'c, 'm> ExpFlow<'c, 'm> {
     /// The flow in `sys` at fundamental `omega`, with state scales `s_q`, `s_v` and the fastest
-    /// frequency `omega_max` along the orbit.
+    /// frequency `omega_max` along the orbit, and the generators `kept` from the last analysis.
     pub(crate) fn new(
         sys: &'c Coordinates<'m>,
-        omega: f64,
-        scale_q: f64,
-        scale_v: f64,
-        omega_max: f64,
+        (omega, scale_q, scale_v, omega_max): (f64, f64, f64, f64),
         max_steps: usize,
+        kept: KeptGenerators,
     ) -> Result<Self> {
         let n = sys.len();
         let m_inv = sys
@@ -127,7 +128,8 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
         let fastest = omega_max.max(omega).max(forcing.top());
         let delta0 = f64::powi(2.0, -(fastest.log2().ceil() as i32));
         let turns = forcing.turns(delta0);
-        let assembler = Box::new(Assembler::new(2 * n, &sys.weights, &mw));
+        let (cores, spare) = kept.split();
+        let assembler = Box::new(Assembler::new(2 * n, &sys.weights, &mw).with_spare(spare));
         let pieces = Pieces::new(sys);
         let kinks = Kinked::new(sys, |e| pieces.has_kinks(e), scale_q, scale_v);
         Ok(Self {
@@ -146,6 +148,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             turns,
             work: ExpWork::new(2 * n),
             states: Vec::new(),
+            cores,
             index: HashMap::new(),
             taylor: Expansion::default(),
             kinks,
@@ -184,7 +187,9 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                         }
                     }
                 }
-                let s = State::new(a, offset, &self.forcing, self.delta0, &mut self.work);
+                let (fine, degree) = Core::fine(norm1(&a), &self.forcing, self.delta0);
+                let core = self.cores.core(a, self.delta0, fine, &mut self.work);
+                let s = State::new(core, degree, offset, &self.forcing, self.delta0);
                 if let Some(link) = &mut self.link {
                     link.send(Message::Generator(s.core.clone()));
                 }
@@ -197,6 +202,14 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             state,
             coefficients,
         }
+    }
+
+    /// The generators of this analysis, for the next (the assembler back on this thread).
+    pub(crate) fn kept(&mut self) -> KeptGenerators {
+        KeptGenerators::join(
+            std::mem::take(&mut self.cores),
+            self.assembler.take_propagators(),
+        )
     }
 
     /// `true` if every law at `x̃` and `theta` still has the piece's coefficients.

@@ -164,11 +164,53 @@ impl Forcing {
 }
 
 /// What both the orbit and its monodromy matrix need of one generator `Ã`: its powers and the
-/// exact sub-step `E_δ₀` (shared with the monodromy side, which may run on another thread).
+/// exact sub-step `E_δ₀` (shared with the monodromy side, which may run on another thread),
+/// and the sub-steps `E_δ` of the doubling `δ = δ₀/2^f, …, δ₀/2` that forms the load's part
+/// `X_δ₀` of every point. A sweep's points keep it ([`KeptGenerators`](super::kept::KeptGenerators)):
+/// it depends on `Ã`, `δ₀` and `f` alone, not on the speed.
 pub(crate) struct Core {
     pub(crate) powers: Powers,
     /// `E_δ₀`.
     pub(crate) e0: DMatrix<f64>,
+    /// `E_δ` for `δ = δ₀/2^f, …, δ₀/2` (`f` entries, the finest first).
+    pub(crate) levels: Vec<DMatrix<f64>>,
+}
+
+impl Core {
+    /// The core of `a` with sub-step `delta0`, `E_δ₀` formed at `δ₀/2^fine` by the Taylor
+    /// polynomial and squared `fine` times.
+    pub(crate) fn new(a: DMatrix<f64>, delta0: f64, fine: u32, work: &mut ExpWork) -> Self {
+        let powers = Powers::new(a);
+        let m = powers.a.nrows();
+        let mut e = DMatrix::zeros(m, m);
+        work.taylor(&powers, delta0 / f64::powi(2.0, fine as i32), &mut e);
+        let mut levels = Vec::with_capacity(fine as usize);
+        let mut squared = e.clone();
+        for _ in 0..fine {
+            product(&e, &e, &mut squared);
+            levels.push(std::mem::replace(&mut e, squared.clone()));
+        }
+        Self {
+            powers,
+            e0: e,
+            levels,
+        }
+    }
+
+    /// The halvings `f` of `δ₀` at which both the Taylor polynomial of `e^{Ãδ}` (`‖Ã‖₁ δ <=
+    /// 1`) and the forcing's series (a degree up to 8) converge, and that degree.
+    pub(crate) fn fine(norm: f64, forcing: &Forcing, delta0: f64) -> (u32, usize) {
+        let mut fine = squarings(norm * delta0);
+        loop {
+            let x = forcing.top() * delta0 / f64::powi(2.0, fine as i32);
+            match (1..=MAX_DEGREE)
+                .find(|&p| x.powi(p as i32 + 1) * inverse_factorial(p + 1) < 1e-16)
+            {
+                Some(p) => return (fine, p),
+                None => fine += 1,
+            }
+        }
+    }
 }
 
 /// What the orbit keeps of one generator `Ã`.
@@ -181,32 +223,21 @@ pub(crate) struct State {
 }
 
 impl State {
-    /// The state of `a` with the forcing `forcing` plus `offset`, sub-step `delta0`.
+    /// The state of the generator `core` (its `f` halvings from [`Core::fine`], with `degree`)
+    /// with the forcing `forcing` plus `offset`, sub-step `delta0`.
     pub(crate) fn new(
-        a: DMatrix<f64>,
+        core: Arc<Core>,
+        degree: usize,
         offset: DVector<f64>,
         forcing: &Forcing,
         delta0: f64,
-        work: &mut ExpWork,
     ) -> Self {
-        let powers = Powers::new(a);
+        let powers = &core.powers;
         let m = powers.a.nrows();
         let n = m / 2;
         let loads = forcing.dirs.ncols();
-        // δ = δ₀/2^f: the Taylor polynomial and the forcing's series both converged.
-        let mut fine = squarings(powers.norm * delta0);
-        let degree = loop {
-            let x = forcing.top() * delta0 / f64::powi(2.0, fine as i32);
-            match (1..=MAX_DEGREE)
-                .find(|&p| x.powi(p as i32 + 1) * inverse_factorial(p + 1) < 1e-16)
-            {
-                Some(p) => break p,
-                None => fine += 1,
-            }
-        };
+        let fine = core.levels.len();
         let mut delta = delta0 / f64::powi(2.0, fine as i32);
-        let mut e = DMatrix::zeros(m, m);
-        work.taylor(&powers, delta, &mut e);
         // φ_{j+1}(Ãδ) [0; G | offset], then X_δ = Σ_j δ^{j+1} φ_{j+1} [0; G] C Sʲ + δ φ₁ offset e₀ᵀ.
         let mut v = DMatrix::zeros(m, loads + 1);
         v.view_mut((n, 0), (n, loads)).copy_from(&forcing.dirs);
@@ -224,18 +255,17 @@ impl State {
         for i in 0..m {
             x[(i, 0)] += delta * psi[0][(i, loads)];
         }
-        let (mut doubled, mut squared) = (x.clone(), e.clone());
-        for _ in 0..fine {
-            product(&e, &x, &mut doubled);
+        // X_{2δ} = E_δ X_δ + X_δ e^{Sδ} (two sub-steps in a row).
+        let mut doubled = x.clone();
+        for e in &core.levels {
+            product(e, &x, &mut doubled);
             forcing.rotate(&mut x, delta);
             doubled += &x;
             std::mem::swap(&mut x, &mut doubled);
-            product(&e, &e, &mut squared);
-            std::mem::swap(&mut e, &mut squared);
             delta *= 2.0;
         }
         Self {
-            core: Arc::new(Core { powers, e0: e }),
+            core,
             x0: x,
             offset,
         }

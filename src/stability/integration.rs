@@ -108,6 +108,14 @@ impl<'c, 'm> Integration<'c, 'm> {
         }
     }
 
+    /// The exponential flow's generators, for the next analysis (none from Runge–Kutta).
+    pub(crate) fn kept_generators(&mut self) -> super::kept::KeptGenerators {
+        match self {
+            Integration::Exponential { flow, .. } => flow.kept(),
+            Integration::RungeKutta { .. } => Default::default(),
+        }
+    }
+
     /// Integration steps so far.
     pub(crate) fn steps(&self) -> usize {
         match self {

@@ -74,6 +74,7 @@ mod exponential;
 mod flow;
 mod generator;
 mod integration;
+mod kept;
 mod kernels;
 mod kinks;
 mod modes;

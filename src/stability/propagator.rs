@@ -20,7 +20,11 @@ use nalgebra::DMatrix;
 use std::collections::HashMap;
 use std::sync::Arc;
 
+/// The most powers `E_δ₀^m` a propagator keeps from one point of a sweep to the next.
+const WHOLE_KEPT: usize = 256;
+
 /// The monodromy side of one generator.
+#[derive(Clone)]
 pub(crate) struct Propagator {
     core: Arc<Core>,
     /// `L_j = E_δ₀^{2^j}` for `j >= 1` (`L_0 = E_δ₀` is the core's).
@@ -38,6 +42,19 @@ impl Propagator {
             ladder: Vec::new(),
             whole: HashMap::new(),
             terms: Vec::new(),
+        }
+    }
+
+    /// The generator's core.
+    pub(crate) fn core(&self) -> &Arc<Core> {
+        &self.core
+    }
+
+    /// Forgets the powers `E_δ₀^m` if there are many (a sweep's pieces change length with
+    /// the speed: the ones met long ago are not met again).
+    pub(crate) fn trim(&mut self) {
+        if self.whole.len() > WHOLE_KEPT {
+            self.whole.clear();
         }
     }
 
@@ -127,7 +144,11 @@ mod tests {
         let a = DMatrix::from_fn(m, m, |i, j| ((i * 5 + j * 3) as f64).sin() * 0.2);
         let powers = Powers::new(a.clone());
         let e0 = (&a * 0.1).exp();
-        let mut prop = Propagator::new(Arc::new(Core { powers, e0 }));
+        let mut prop = Propagator::new(Arc::new(Core {
+            powers,
+            e0,
+            levels: Vec::new(),
+        }));
         let start = DMatrix::from_fn(m, m, |i, j| ((i + 2 * j) as f64).cos());
         let mut tmp = DMatrix::zeros(m, m);
         // Twice each (the second from the kept power), and a single bit.

@@ -22,6 +22,7 @@ use super::pipeline::{Link, Message};
 use super::propagator::Propagator;
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// One factor of the monodromy matrix of a pass.
@@ -45,6 +46,8 @@ type Element = (Vec<(usize, f64)>, Vec<f64>);
 /// product of a record's factors, step by step.
 pub(crate) struct Assembler {
     propagators: Vec<Propagator>,
+    /// Propagators kept from the last analysis, by their core's address.
+    spare: HashMap<usize, Propagator>,
     /// `(w̃_e, M⁻¹ w_e)` per element (the saltation matrices).
     elements: Vec<Element>,
     work: ExpWork,
@@ -64,12 +67,27 @@ impl Assembler {
             .collect();
         Self {
             propagators: Vec::new(),
+            spare: HashMap::new(),
             elements,
             work: ExpWork::new(s2),
             phi: DMatrix::identity(s2, s2),
             tmp: DMatrix::zeros(s2, s2),
             e_tau: DMatrix::zeros(s2, s2),
         }
+    }
+
+    /// With the propagators `spare` kept from the last analysis.
+    pub(crate) fn with_spare(mut self, spare: HashMap<usize, Propagator>) -> Self {
+        self.spare = spare;
+        self
+    }
+
+    /// The propagators, for the next analysis (each trimmed).
+    pub(crate) fn take_propagators(&mut self) -> Vec<Propagator> {
+        let mut all = std::mem::take(&mut self.propagators);
+        all.extend(self.spare.drain().map(|(_, p)| p));
+        all.iter_mut().for_each(Propagator::trim);
+        all
     }
 
     /// Generators known so far.
@@ -79,7 +97,8 @@ impl Assembler {
 
     /// The next generator (the flow's states in their order).
     pub(crate) fn add(&mut self, core: Arc<Core>) {
-        self.propagators.push(Propagator::new(core));
+        self.propagators
+            .push(super::kept::propagator(&mut self.spare, core));
     }
 
     /// `Φ̃ = I`: a new pass.

@@ -7,6 +7,7 @@ use super::chord::{iterate, KeptJacobian, Problem};
 use super::exponential::ExpFlow;
 use super::flow::{Flow, FlowOptions};
 use super::integration::Integration;
+use super::kept::KeptGenerators;
 use super::scales::scales;
 use super::system::Coordinates;
 use super::{affine, eigenvalues, neutral, Floquet, FloquetOptions, Integrator};
@@ -62,6 +63,7 @@ pub(crate) fn shoot(
     start: Start,
     goal: Goal,
     jacobian: Option<&KeptJacobian>,
+    kept: &mut KeptGenerators,
 ) -> Result<Shot> {
     let n_model = sys.model.n_dofs();
     let n = sys.len();
@@ -102,11 +104,9 @@ pub(crate) fn shoot(
     {
         Integration::exponential(ExpFlow::new(
             sys,
-            omega,
-            scale_q,
-            scale_v,
-            omega_max,
+            (omega, scale_q, scale_v, omega_max),
             options.max_steps,
+            std::mem::take(kept),
         )?)
     } else {
         runge_kutta()?
@@ -146,6 +146,7 @@ pub(crate) fn shoot(
     };
     let jacobian = jacobian.and_then(|j| j.in_scales(sys, (scale_q, scale_v)));
     let outcome = iterate(&problem, &mut flow, &runge_kutta, &mut x0, jacobian)?;
+    *kept = flow.kept_generators();
     let phi = outcome.phi;
     // The exact orbit's start in the model's DOFs, against the HB state there.
     let lift = |x: &[f64]| {
