@@ -161,7 +161,9 @@ impl Pieces {
 
     /// The first crossing of element `e` out of its piece inside a step of length `h` along
     /// which `u` goes from `u0` (rate `du0`) to `u1` (rate `du1`): `(fraction of the step,
-    /// upwards?)`, from 8 probes of the cubic Hermite interpolant and bisection on it. A
+    /// upwards?)`, on the cubic Hermite interpolant: it is monotone between the roots of its
+    /// derivative (a quadratic), so the first of those pieces whose end lies outside holds the
+    /// first crossing, found by bisection (a crossing between fixed probes is not missed). A
     /// crossing is counted once `u` is `1e-13 (s_q + |kink|)` beyond the edge.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn crossing(
@@ -194,11 +196,9 @@ impl Pieces {
                 None
             }
         };
-        const PROBES: usize = 8;
         let mut prev_s = 0.0;
-        for p in 1..=PROBES {
-            let s = p as f64 / PROBES as f64;
-            let u = if p == PROBES {
+        for s in monotone_pieces(u0, u1, h * du0, h * du1) {
+            let u = if s == 1.0 {
                 u1
             } else {
                 hermite(u0, u1, du0, du1, h, s)
@@ -224,6 +224,35 @@ impl Pieces {
     }
 }
 
+/// The ends of the pieces of `[0, 1]` on which the cubic Hermite interpolant with values
+/// `u0`, `u1` and scaled rates `hd0 = h u̇0`, `hd1 = h u̇1` is monotone: the roots in `(0, 1)`
+/// of its derivative `3a s² + 2b s + c` (`a = 2(u0 - u1) + hd0 + hd1`,
+/// `b = 3(u1 - u0) - 2 hd0 - hd1`, `c = hd0`), then 1.
+fn monotone_pieces(u0: f64, u1: f64, hd0: f64, hd1: f64) -> impl Iterator<Item = f64> {
+    let a = 2.0 * (u0 - u1) + hd0 + hd1;
+    let b = 3.0 * (u1 - u0) - 2.0 * hd0 - hd1;
+    let c = hd0;
+    let (mut r1, mut r2) = (f64::NAN, f64::NAN);
+    let disc = b * b - 3.0 * a * c;
+    if disc >= 0.0 {
+        // The stable pair of roots of 3a s² + 2b s + c.
+        let q = -(b + b.signum() * disc.sqrt());
+        if q != 0.0 {
+            r1 = q / (3.0 * a);
+            r2 = c / q;
+        } else if a != 0.0 {
+            r1 = 0.0;
+        }
+    }
+    if r1 > r2 {
+        std::mem::swap(&mut r1, &mut r2);
+    }
+    [r1, r2]
+        .into_iter()
+        .filter(|r| *r > 0.0 && *r < 1.0)
+        .chain(std::iter::once(1.0))
+}
+
 /// `Φ̃ ← S Φ̃` for the saltation matrix of a force jump of an element with weights `w̃_e`
 /// (`weights`) and factor `c` ([`Pieces::cross_jump`]): every column gets
 /// `δṽ += c M⁻¹ w_e (w̃_e·δq̃)` (`mw` = `M⁻¹ w_e`, `phi` column-major with `2n` rows).
@@ -241,4 +270,32 @@ pub(crate) fn saltation(weights: &[(usize, f64)], factor: f64, mw: &[f64], phi: 
 fn nudge(x: f64, direction: f64) -> f64 {
     let step = 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE);
     x + direction * step
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A crest of the interpolant between the eighths of the step, 1e-9 above the edge, is a
+    /// crossing (eight probes saw none); 1e-9 below it is none.
+    #[test]
+    fn a_crest_between_probes_crosses() {
+        let (u0, u1, du0, du1, h) = (0.0, 0.1, 1.0, -0.9, 1.0);
+        let fine = (0..=100_000).map(|i| hermite(u0, u1, du0, du1, h, i as f64 * 1e-5));
+        let top = fine.fold(f64::NEG_INFINITY, f64::max);
+        let probes = (1..=8).map(|p| hermite(u0, u1, du0, du1, h, p as f64 / 8.0));
+        let probed = probes.fold(f64::NEG_INFINITY, f64::max);
+        assert!(top - probed > 1e-4, "{top} {probed}");
+        let at = |edge: f64| {
+            let pieces = Pieces {
+                kinks: vec![vec![edge]],
+                side: vec![0],
+            };
+            pieces.crossing(0, u0, u1, du0, du1, h, 1e-6)
+        };
+        let (s, up) = at(top - 1e-9).expect("a crossing");
+        assert!(up && (hermite(u0, u1, du0, du1, h, s) - (top - 1e-9)).abs() < 1e-12);
+        assert_eq!(at(top + 1e-9), None);
+        assert_eq!(at(probed - 1e-9).map(|c| c.1), Some(true));
+    }
 }
