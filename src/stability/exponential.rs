@@ -270,6 +270,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 let mut done = 0;
                 let mut hit = None;
                 self.kink_states(&x, &mut at_start);
+                self.kinks.refresh(&self.pieces, self.scale_q);
                 self.forcing.oscillator(t, &mut z);
                 for _ in 0..whole as usize {
                     let terms = [(state.e0(), x.as_slice()), (&state.x0, z.as_slice())];
