@@ -35,7 +35,7 @@
 
 use super::expm::{norm1, ExpWork};
 use super::generator::{Core, Expansion, Forcing, State};
-use super::kept::{Cores, KeptGenerators};
+use super::kept::{Cores, KeptGenerators, WordMap};
 use super::kernels::gemv_sum;
 use super::kinks::Kinked;
 use super::pieces::Pieces;
@@ -44,7 +44,6 @@ use super::record::{Assembler, Step};
 use super::system::Coordinates;
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
-use std::collections::HashMap;
 
 /// The flow over one period by exponentials.
 pub(crate) struct ExpFlow<'c, 'm> {
@@ -70,7 +69,7 @@ pub(crate) struct ExpFlow<'c, 'm> {
     pub(super) states: Vec<State>,
     /// Their cores, kept from the last analysis or formed here.
     cores: Cores,
-    index: HashMap<Vec<u64>, usize>,
+    index: WordMap<Vec<u64>, usize>,
     /// The Taylor series of the exact solution from the last expansion point.
     pub(super) taylor: Expansion,
     /// The elements with kinks.
@@ -149,7 +148,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             work: ExpWork::new(2 * n),
             states: Vec::new(),
             cores,
-            index: HashMap::new(),
+            index: WordMap::default(),
             taylor: Expansion::default(),
             kinks,
             steps: 0,

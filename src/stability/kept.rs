@@ -16,11 +16,43 @@ use nalgebra::DMatrix;
 use std::collections::HashMap;
 use std::sync::Arc;
 
+/// A hash of the words of a key of bits (rotate, xor, multiply by an odd constant per word):
+/// the keys here are hundreds of words whose every bit matters, where SipHash cost a
+/// microsecond a key.
+#[derive(Default, Clone, Copy)]
+pub(crate) struct WordHasher(u64);
+
+impl std::hash::Hasher for WordHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(word));
+        }
+    }
+
+    fn write_u64(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+
+    fn write_usize(&mut self, word: usize) {
+        self.write_u64(word as u64);
+    }
+}
+
+/// A map keyed by words with [`WordHasher`].
+pub(crate) type WordMap<K, V> =
+    HashMap<K, V, std::hash::BuildHasherDefault<WordHasher>>;
+
 /// The generators of the last analysis, for the next.
 #[derive(Clone, Default)]
 pub(crate) struct KeptGenerators {
     /// Cores by the bits of `(δ₀, f, Ã)`.
-    cores: HashMap<Vec<u64>, Arc<Core>>,
+    cores: WordMap<Vec<u64>, Arc<Core>>,
     /// Propagators by their core's address.
     propagators: HashMap<usize, Propagator>,
 }
@@ -53,8 +85,8 @@ fn address(core: &Arc<Core>) -> usize {
 /// The cores of one analysis: the kept ones it meets again and the new ones.
 #[derive(Default)]
 pub(crate) struct Cores {
-    kept: HashMap<Vec<u64>, Arc<Core>>,
-    used: HashMap<Vec<u64>, Arc<Core>>,
+    kept: WordMap<Vec<u64>, Arc<Core>>,
+    used: WordMap<Vec<u64>, Arc<Core>>,
 }
 
 impl Cores {
@@ -85,7 +117,7 @@ impl KeptGenerators {
         (
             Cores {
                 kept: self.cores,
-                used: HashMap::new(),
+                used: WordMap::default(),
             },
             self.propagators,
         )
