@@ -33,7 +33,7 @@ pub(crate) struct Forcing {
     dirs: DMatrix<f64>,
     /// `C Sʲ`, `j = 0..=MAX_DEGREE`.
     channels: Vec<DMatrix<f64>>,
-    /// `[0; G C]` (2n × oscillator states: the load on the rates).
+    /// `G C` (n × oscillator states): the load on the rates; the positions get none.
     load: DMatrix<f64>,
     /// `S`.
     generator: DMatrix<f64>,
@@ -79,9 +79,7 @@ impl Forcing {
             let next = &channels[j - 1] * &generator;
             channels.push(next);
         }
-        let mut load = DMatrix::zeros(2 * n, channels[0].ncols());
-        load.view_mut((n, 0), (n, channels[0].ncols()))
-            .copy_from(&(&dirs * &channels[0]));
+        let load = &dirs * &channels[0];
         Self {
             omega,
             orders,
@@ -146,7 +144,7 @@ impl Forcing {
             .collect()
     }
 
-    /// `[0; G C]`: the scaled load is `[0; G C] z` (`Sⁱ z` for its `i`-th time derivative).
+    /// `G C`: the scaled load is `[0; G C] z` (`Sⁱ z` for its `i`-th time derivative).
     pub(crate) fn load(&self) -> &DMatrix<f64> {
         &self.load
     }
@@ -174,12 +172,19 @@ pub(crate) struct Core {
     pub(crate) e0: DMatrix<f64>,
     /// `E_δ` for `δ = δ₀/2^f, …, δ₀/2` (`f` entries, the finest first).
     pub(crate) levels: Vec<DMatrix<f64>>,
+    /// The rates' rows of `Ã` (`n × 2n`); its positions' rows are `[0, ω_s I]`.
+    lower: DMatrix<f64>,
+    /// `ω_s = s_v/s_q`.
+    omega_s: f64,
 }
 
 impl Core {
     /// The core of `a` with sub-step `delta0`, `E_δ₀` formed at `δ₀/2^fine` by the Taylor
     /// polynomial and squared `fine` times.
     pub(crate) fn new(a: DMatrix<f64>, delta0: f64, fine: u32, work: &mut ExpWork) -> Self {
+        let n = a.nrows() / 2;
+        let lower = a.rows(n, n).into_owned();
+        let omega_s = if n > 0 { a[(0, n)] } else { 0.0 };
         let powers = Powers::new(a);
         let m = powers.a.nrows();
         let mut e = DMatrix::zeros(m, m);
@@ -194,6 +199,8 @@ impl Core {
             powers,
             e0: e,
             levels,
+            lower,
+            omega_s,
         }
     }
 
@@ -275,11 +282,6 @@ impl State {
     pub(crate) fn e0(&self) -> &DMatrix<f64> {
         &self.core.e0
     }
-
-    /// `Ã`.
-    pub(crate) fn a(&self) -> &DMatrix<f64> {
-        &self.core.powers.a
-    }
 }
 
 /// The Taylor series of the exact solution of a piece through a state:
@@ -324,13 +326,18 @@ impl Expansion {
             }
             let (done, next) = self.derivs.split_at_mut(i + 1);
             let next = &mut next[0];
-            // x̃⁽ⁱ⁺¹⁾ = Ã x̃⁽ⁱ⁾ + [0; G C] Sⁱ z.
+            // x̃⁽ⁱ⁺¹⁾ = Ã x̃⁽ⁱ⁾ + [0; G C] Sⁱ z: the positions' rows are ω_s times the rates
+            // (the same bits as the whole product), the rates' rows a product.
+            let core = &state.core;
+            let (top, v) = next.as_mut_slice().split_at_mut(n);
+            for (t, r) in top.iter_mut().zip(&done[i].as_slice()[n..]) {
+                *t = core.omega_s * r;
+            }
             let terms = [
-                (state.a(), done[i].as_slice()),
+                (&core.lower, done[i].as_slice()),
                 (forcing.load(), z.as_slice()),
             ];
-            gemv_sum(&terms, next.as_mut_slice(), false);
-            let v = &mut next.as_mut_slice()[n..];
+            gemv_sum(&terms, v, false);
             forcing.differentiate(z);
             if i == 0 {
                 for (o, c) in v.iter_mut().zip(&state.offset.as_slice()[n..]) {

@@ -45,8 +45,7 @@ impl std::hash::Hasher for WordHasher {
 }
 
 /// A map keyed by words with [`WordHasher`].
-pub(crate) type WordMap<K, V> =
-    HashMap<K, V, std::hash::BuildHasherDefault<WordHasher>>;
+pub(crate) type WordMap<K, V> = HashMap<K, V, std::hash::BuildHasherDefault<WordHasher>>;
 
 /// The generators of the last analysis, for the next.
 #[derive(Clone, Default)]

@@ -136,19 +136,13 @@ impl Propagator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stability::expm::Powers;
 
     #[test]
     fn whole_sub_steps_are_the_power_of_the_sub_step() {
         let m = 6;
         let a = DMatrix::from_fn(m, m, |i, j| ((i * 5 + j * 3) as f64).sin() * 0.2);
-        let powers = Powers::new(a.clone());
-        let e0 = (&a * 0.1).exp();
-        let mut prop = Propagator::new(Arc::new(Core {
-            powers,
-            e0,
-            levels: Vec::new(),
-        }));
+        let mut prop =
+            Propagator::new(Arc::new(Core::new(a.clone(), 0.1, 0, &mut ExpWork::new(m))));
         let start = DMatrix::from_fn(m, m, |i, j| ((i + 2 * j) as f64).cos());
         let mut tmp = DMatrix::zeros(m, m);
         // Twice each (the second from the kept power), and a single bit.
