@@ -176,6 +176,9 @@ pub(crate) struct Core {
     lower: DMatrix<f64>,
     /// `ω_s = s_v/s_q`.
     omega_s: f64,
+    /// `δ₀` and the halvings `f`.
+    delta0: f64,
+    fine: u32,
 }
 
 impl Core {
@@ -201,7 +204,23 @@ impl Core {
             levels,
             lower,
             omega_s,
+            delta0,
+            fine,
         }
+    }
+
+    /// `true` if this is the core of `a` with sub-step `delta0` and `fine` halvings, to the
+    /// bit.
+    pub(crate) fn is(&self, a: &DMatrix<f64>, delta0: f64, fine: u32) -> bool {
+        self.delta0.to_bits() == delta0.to_bits()
+            && self.fine == fine
+            && self.powers.a.shape() == a.shape()
+            && self
+                .powers
+                .a
+                .iter()
+                .zip(a.iter())
+                .all(|(x, y)| x.to_bits() == y.to_bits())
     }
 
     /// The halvings `f` of `δ₀` at which both the Taylor polynomial of `e^{Ãδ}` (`‖Ã‖₁ δ <=

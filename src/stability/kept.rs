@@ -50,8 +50,8 @@ pub(crate) type WordMap<K, V> = HashMap<K, V, std::hash::BuildHasherDefault<Word
 /// The generators of the last analysis, for the next.
 #[derive(Clone, Default)]
 pub(crate) struct KeptGenerators {
-    /// Cores by the bits of `(δ₀, f, Ã)`.
-    cores: WordMap<Vec<u64>, Arc<Core>>,
+    /// Cores by a hash of the bits of `(δ₀, f, Ã)` ([`Core::is`] checks them).
+    cores: WordMap<u64, Arc<Core>>,
     /// Propagators by their core's address.
     propagators: HashMap<usize, Propagator>,
 }
@@ -67,13 +67,16 @@ impl std::fmt::Debug for KeptGenerators {
     }
 }
 
-/// The key of a core.
-fn key(a: &DMatrix<f64>, delta0: f64, fine: u32) -> Vec<u64> {
-    let mut k = Vec::with_capacity(a.len() + 2);
-    k.push(delta0.to_bits());
-    k.push(fine as u64);
-    k.extend(a.iter().map(|v| v.to_bits()));
-    k
+/// The hash of a core's key: the bits of `δ₀`, `f` and `Ã`.
+fn key(a: &DMatrix<f64>, delta0: f64, fine: u32) -> u64 {
+    use std::hash::Hasher;
+    let mut h = WordHasher::default();
+    h.write_u64(delta0.to_bits());
+    h.write_u64(fine as u64);
+    for v in a.iter() {
+        h.write_u64(v.to_bits());
+    }
+    h.finish()
 }
 
 /// A core's address, the key of its propagator.
@@ -84,8 +87,8 @@ fn address(core: &Arc<Core>) -> usize {
 /// The cores of one analysis: the kept ones it meets again and the new ones.
 #[derive(Default)]
 pub(crate) struct Cores {
-    kept: WordMap<Vec<u64>, Arc<Core>>,
-    used: WordMap<Vec<u64>, Arc<Core>>,
+    kept: WordMap<u64, Arc<Core>>,
+    used: WordMap<u64, Arc<Core>>,
 }
 
 impl Cores {
@@ -98,13 +101,13 @@ impl Cores {
         work: &mut ExpWork,
     ) -> Arc<Core> {
         let k = key(&a, delta0, fine);
-        if let Some(c) = self.used.get(&k) {
+        if let Some(c) = self.used.get(&k).filter(|c| c.is(&a, delta0, fine)) {
             return c.clone();
         }
-        let c = self
-            .kept
-            .remove(&k)
-            .unwrap_or_else(|| Arc::new(Core::new(a, delta0, fine, work)));
+        let c = match self.kept.remove(&k) {
+            Some(c) if c.is(&a, delta0, fine) => c,
+            _ => Arc::new(Core::new(a, delta0, fine, work)),
+        };
         self.used.insert(k, c.clone());
         c
     }
