@@ -145,14 +145,25 @@ fn extreme(q: &[Complex64], series: &[f64], top: usize, sense: f64, bound: f64) 
     let floor = sense * series[top] - bound;
     let mut best = refine_extremum(q, series, top, sense);
     let mut others: Vec<(f64, usize)> = Vec::new();
-    for (j, &v) in series.iter().enumerate() {
-        let s = sense * v;
-        if j == top || s < floor {
+    // Blocks of 8 samples, skipped whole where none reaches the floor (a vectorised maximum).
+    const BLOCK: usize = 8;
+    for (b, block) in series.chunks(BLOCK).enumerate() {
+        let high = block
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, &v| m.max(sense * v));
+        if high < floor {
             continue;
         }
-        let (before, after) = (series[(j + points - 1) % points], series[(j + 1) % points]);
-        if s >= sense * before && s >= sense * after {
-            others.push((s, j));
+        for (i, &v) in block.iter().enumerate() {
+            let j = b * BLOCK + i;
+            let s = sense * v;
+            if j == top || s < floor {
+                continue;
+            }
+            let (before, after) = (series[(j + points - 1) % points], series[(j + 1) % points]);
+            if s >= sense * before && s >= sense * after {
+                others.push((s, j));
+            }
         }
     }
     if others.len() > CANDIDATES {
@@ -226,9 +237,13 @@ fn refine_extremum(q: &[Complex64], series: &[f64], j: usize, sense: f64) -> f64
     if offset.is_finite() && offset.abs() <= 0.5 {
         t += offset * step;
     }
+    // The value at the last step's end from the quadratic model at its start: the step
+    // is within 1e-9 of the spacing, so the model's O(δθ³) error is far below rounding.
+    let mut v = f64::NAN;
     for _ in 0..20 {
-        let (_, d1, d2) = derivs(t);
+        let (value, d1, d2) = derivs(t);
         if d2 == 0.0 || !d1.is_finite() {
+            v = value;
             break;
         }
         let next = (t - d1 / d2).clamp(theta - step, theta + step);
@@ -236,12 +251,15 @@ fn refine_extremum(q: &[Complex64], series: &[f64], j: usize, sense: f64) -> f64
         // 1e-18 of q'' step², below rounding; rounding in q'/q'' keeps Newton's steps
         // from falling much lower, so a tighter test would run all iterations.
         if (next - t).abs() <= 1e-9 * step {
-            t = next;
+            let dt = next - t;
+            v = value + dt * (d1 + 0.5 * d2 * dt);
             break;
         }
         t = next;
     }
-    let (v, _, _) = derivs(t);
+    if v.is_nan() {
+        v = derivs(t).0;
+    }
     if v.is_finite() && sense * (v - at) >= 0.0 {
         v
     } else {
@@ -307,7 +325,7 @@ mod tests {
         let alone = refine_extremum(&q, &coarse, clo, -1.0);
         assert!(alone - exact_lo > 1e-5, "{}", alone - exact_lo);
         // max |q|: the minimum's side (|-1.3| > 0.7), refined the same way.
-        assert_eq!(max_abs_of(&q, &coarse), -lo);
-        assert_eq!(sol.max_abs(0), -lo);
+        assert!((max_abs_of(&q, &coarse) + lo).abs() < 1e-14);
+        assert!((sol.max_abs(0) + lo).abs() < 1e-14);
     }
 }
