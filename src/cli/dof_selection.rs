@@ -12,12 +12,19 @@ use hbal::Model;
 pub(crate) const ALL_UP_TO: usize = 64;
 
 /// The DOFs to report (indices in the model's order) from `--dofs`: `all`, a comma-separated
-/// list of DOF names, or by default every DOF up to [`ALL_UP_TO`], else those of the elements
-/// and loads.
+/// list of DOF names (or one name that holds a comma), or by default every DOF up to
+/// [`ALL_UP_TO`], else those of the elements and loads.
 pub(crate) fn reported_dofs(model: &Model, spec: Option<&str>) -> anyhow::Result<Vec<usize>> {
     let names = model.dof_names();
     let n = names.len();
-    let mut chosen = match spec.map(str::trim) {
+    let spec = spec.map(str::trim);
+    // A whole list that is one DOF's name (a name may hold a comma).
+    if let Some(i) = spec.and_then(|s| names.iter().position(|d| d == s)) {
+        if spec != Some("all") {
+            return Ok(vec![i]);
+        }
+    }
+    let mut chosen = match spec {
         Some("all") => return Ok((0..n).collect()),
         None if n <= ALL_UP_TO => return Ok((0..n).collect()),
         None => {

@@ -144,7 +144,7 @@ pub(crate) fn parameter_sweep(
         std::fs::create_dir_all(dir)?;
         std::fs::write(
             dir.join("branch.csv"),
-            hbal::report::branch_csv_orders(
+            hbal::report::branch_csv_of_dofs(
                 &branch,
                 probe.fundamental_order,
                 &reported,

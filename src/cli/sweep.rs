@@ -298,7 +298,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         std::fs::create_dir_all(dir)?;
         std::fs::write(
             dir.join("branch.csv"),
-            hbal::report::branch_csv_orders(
+            hbal::report::branch_csv_of_dofs(
                 &branch,
                 scene.fundamental_order,
                 &reported,
@@ -310,7 +310,13 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         for (i, b) in secondary.iter().enumerate() {
             std::fs::write(
                 dir.join(format!("branch_{}.csv", i + 1)),
-                hbal::report::branch_csv_orders(b, scene.fundamental_order, &reported, unit, speed),
+                hbal::report::branch_csv_of_dofs(
+                    b,
+                    scene.fundamental_order,
+                    &reported,
+                    unit,
+                    speed,
+                ),
             )?;
         }
         if branch.points.len() >= 2 {

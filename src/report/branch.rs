@@ -16,13 +16,24 @@ use std::path::Path;
 /// the harmonic k and its order o = k/ν of the fundamental (ν the branch's period multiple);
 /// [`branch_csv_orders`] states the fundamental's order of a reference shaft.
 pub fn branch_csv(branch: &Branch, parameter_name: &str, parameter: impl Fn(f64) -> f64) -> String {
-    let every: Vec<usize> = (0..branch.dofs.len()).collect();
-    branch_csv_orders(branch, 1.0, &every, parameter_name, parameter)
+    branch_csv_orders(branch, 1.0, parameter_name, parameter)
 }
 
 /// [`branch_csv`] with harmonic k named as order `k · fundamental_order / ν` of the reference
-/// shaft, and the amplitudes of the DOFs `amplitudes` only (indices; `max|q|` of every DOF).
+/// shaft.
 pub fn branch_csv_orders(
+    branch: &Branch,
+    fundamental_order: f64,
+    parameter_name: &str,
+    parameter: impl Fn(f64) -> f64,
+) -> String {
+    let every: Vec<usize> = (0..branch.dofs.len()).collect();
+    branch_csv_of_dofs(branch, fundamental_order, &every, parameter_name, parameter)
+}
+
+/// [`branch_csv_orders`] with the amplitudes of the DOFs `amplitudes` only (indices into
+/// `branch.dofs`; `max|q|` of every DOF): `hbal sweep --dofs`.
+pub fn branch_csv_of_dofs(
     branch: &Branch,
     fundamental_order: f64,
     amplitudes: &[usize],

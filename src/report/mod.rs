@@ -9,7 +9,7 @@ mod plot;
 mod timing;
 mod waterfall;
 
-pub use branch::{branch_csv, branch_csv_orders, branch_plot, branches_plot};
+pub use branch::{branch_csv, branch_csv_of_dofs, branch_csv_orders, branch_plot, branches_plot};
 pub use element_output::{element_outputs, ElementOutput, MeshOutput, Signal};
 pub use element_report::ElementReport;
 pub use html::{escape, HtmlReport};

@@ -24,11 +24,12 @@ impl Solution {
     }
 
     /// `(min q_dof, max q_dof)` over one period: the extremes of samples that resolve the
-    /// highest harmonic eight times (at least 64), refined by Newton on `q'(θ) = 0` with the
+    /// highest harmonic sixteen times (at least 64), refined by Newton on `q'(θ) = 0` with the
     /// analytic derivatives of the harmonics, so exact to rounding instead of to the
-    /// sampling's `O(δθ²)`. Every sampled local extremum within the sampling's bound
-    /// `B = ⅛ δθ² Σ k²|q_k|` of the sampled extreme is refined: a second peak that the
-    /// samples show lower than the first by less than `B` may be the higher one.
+    /// sampling's `O(δθ²)`. The sampled local extrema within the sampling's bound
+    /// `B = ⅛ δθ² Σ k²|q_k|` of the sampled extreme are refined too (the 8 most extreme): a
+    /// second peak that the samples show lower than the first by less than `B` may be the
+    /// higher one.
     pub fn extremes(&self, dof: usize) -> (f64, f64) {
         let points = self.extreme_points();
         let series = self.time_series(dof, points);
@@ -79,7 +80,7 @@ impl Solution {
             .collect()
     }
 
-    /// Samples the extremes are searched on: eight per period of the highest harmonic, a
+    /// Samples the extremes are searched on: sixteen per period of the highest harmonic, a
     /// power of two, at least 64.
     fn extreme_points(&self) -> usize {
         (16 * self.basis.harmonics()).next_power_of_two().max(64)
@@ -117,6 +118,10 @@ fn max_abs_of(q: &[Complex64], series: &[f64]) -> f64 {
     }
     if -lo + bound >= hi {
         out = out.max(-extreme(q, series, imin, -1.0, bound));
+    }
+    if out == f64::NEG_INFINITY {
+        // Neither side could be compared: the samples are not numbers.
+        return f64::NAN;
     }
     out.abs()
 }

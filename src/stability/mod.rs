@@ -67,6 +67,7 @@
 
 mod affine;
 mod chord;
+mod cubic;
 mod dispatch;
 mod dopri;
 mod expm;

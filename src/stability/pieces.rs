@@ -4,6 +4,7 @@
 //! state, and the first crossing of a kink inside a step from the cubic Hermite interpolant of
 //! `u` (values and rates at both ends); the saltation matrix of a force jump at a crossing.
 
+use super::cubic::Cubic;
 use super::dopri::hermite;
 use super::system::Coordinates;
 
@@ -163,7 +164,8 @@ impl Pieces {
     /// which `u` goes from `u0` (rate `du0`) to `u1` (rate `du1`): `(fraction of the step,
     /// upwards?)`, on the cubic Hermite interpolant: it is monotone between the roots of its
     /// derivative (a quadratic), so the first of those pieces whose end lies outside holds the
-    /// first crossing, found by bisection (a crossing between fixed probes is not missed). A
+    /// first crossing, found by Newton in that bracket ([`Cubic::first_at`]; a crossing
+    /// between fixed probes is not missed). A
     /// crossing is counted once `u` is `1e-13 (s_q + |kink|)` beyond the edge.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn crossing(
@@ -214,111 +216,6 @@ impl Pieces {
     }
 }
 
-/// The cubic Hermite interpolant over a step as `p(s) = d + c s + b s² + a s³`, `s ∈ [0, 1]`,
-/// from the values `u0`, `u1` and the scaled rates `hd0 = h u̇0`, `hd1 = h u̇1`:
-/// `a = 2(u0 - u1) + hd0 + hd1`, `b = 3(u1 - u0) - 2 hd0 - hd1`, `c = hd0`, `d = u0`.
-struct Cubic {
-    a: f64,
-    b: f64,
-    c: f64,
-    d: f64,
-}
-
-impl Cubic {
-    fn new(u0: f64, u1: f64, hd0: f64, hd1: f64) -> Self {
-        Self {
-            a: 2.0 * (u0 - u1) + hd0 + hd1,
-            b: 3.0 * (u1 - u0) - 2.0 * hd0 - hd1,
-            c: hd0,
-            d: u0,
-        }
-    }
-
-    fn value(&self, s: f64) -> f64 {
-        ((self.a * s + self.b) * s + self.c) * s + self.d
-    }
-
-    fn rate(&self, s: f64) -> f64 {
-        (3.0 * self.a * s + 2.0 * self.b) * s + self.c
-    }
-
-    /// The ends of the pieces of `[0, 1]` on which the cubic is monotone: the roots in
-    /// `(0, 1)` of `p'(s) = 3a s² + 2b s + c`, then 1.
-    fn monotone_pieces(&self) -> impl Iterator<Item = f64> {
-        let (a, b, c) = (self.a, self.b, self.c);
-        let (mut r1, mut r2) = (f64::NAN, f64::NAN);
-        let disc = b * b - 3.0 * a * c;
-        if disc >= 0.0 {
-            // The stable pair of roots of 3a s² + 2b s + c.
-            let q = -(b + b.signum() * disc.sqrt());
-            if q != 0.0 {
-                r1 = q / (3.0 * a);
-                r2 = c / q;
-            } else if a != 0.0 {
-                r1 = 0.0;
-            }
-        }
-        if r1 > r2 {
-            std::mem::swap(&mut r1, &mut r2);
-        }
-        [r1, r2]
-            .into_iter()
-            .filter(|r| *r > 0.0 && *r < 1.0)
-            .chain(std::iter::once(1.0))
-    }
-
-    /// The first `s` in `[lo, hi]` (a monotone piece, `p(lo)` short of `edge`, `p(hi)` at or
-    /// beyond it, beyond meaning above if `up`) with `p(s)` at or beyond `edge`: Newton on
-    /// `p(s) = edge` kept inside the bracket (bisection where it would leave it), then the
-    /// nearest float at or beyond.
-    fn first_at(&self, edge: f64, up: bool, lo: f64, hi: f64) -> f64 {
-        let sense = if up { 1.0 } else { -1.0 };
-        let g = |s: f64| sense * (self.value(s) - edge);
-        // |g| at this level is rounding.
-        let noise = 8.0
-            * f64::EPSILON
-            * (self.a.abs() + self.b.abs() + self.c.abs() + self.d.abs() + edge.abs());
-        let (mut a, mut b) = (lo, hi);
-        let (ga, gb) = (g(a), g(b));
-        let mut x = if gb > ga {
-            a + (b - a) * (-ga / (gb - ga))
-        } else {
-            0.5 * (a + b)
-        };
-        for _ in 0..100 {
-            let gx = g(x);
-            if gx >= 0.0 {
-                b = x;
-            } else {
-                a = x;
-            }
-            if gx.abs() <= noise || b - a <= 2.0 * f64::EPSILON * b {
-                break;
-            }
-            let newton = x - gx / (sense * self.rate(x));
-            x = if newton > a && newton < b {
-                newton
-            } else {
-                0.5 * (a + b)
-            };
-        }
-        if g(x) >= 0.0 {
-            return x;
-        }
-        // Just short of the edge: bisection between there and the bracket's outer end.
-        let mut a = x;
-        for _ in 0..60 {
-            let mid = 0.5 * (a + b);
-            if g(mid) >= 0.0 {
-                b = mid;
-            } else {
-                a = mid;
-            }
-        }
-        b
-    }
-}
-
 /// `Φ̃ ← S Φ̃` for the saltation matrix of a force jump of an element with weights `w̃_e`
 /// (`weights`) and factor `c` ([`Pieces::cross_jump`]): every column gets
 /// `δṽ += c M⁻¹ w_e (w̃_e·δq̃)` (`mw` = `M⁻¹ w_e`, `phi` column-major with `2n` rows).
@@ -363,44 +260,5 @@ mod tests {
         assert!(up && (hermite(u0, u1, du0, du1, h, s) - (top - 1e-9)).abs() < 1e-12);
         assert_eq!(at(top + 1e-9), None);
         assert_eq!(at(probed - 1e-9).map(|c| c.1), Some(true));
-    }
-
-    /// Newton in the bracket finds a point at or beyond the edge where the cubic is at the edge
-    /// to rounding, as bisection to the last bit does (the same point where the root is well
-    /// conditioned), on both edges and on cubics that turn inside the step.
-    #[test]
-    fn newton_in_the_bracket_matches_bisection() {
-        for k in 0..200 {
-            let t = k as f64;
-            let (u0, u1) = ((0.37 * t).sin(), (1.1 * t).cos());
-            let (hd0, hd1) = (2.0 * (0.71 * t).sin(), 2.0 * (0.29 * t).cos());
-            let cubic = Cubic::new(u0, u1, hd0, hd1);
-            let mut lo = 0.0;
-            for hi in cubic.monotone_pieces() {
-                let (va, vb) = (cubic.value(lo), cubic.value(hi));
-                let (edge, up) = (0.5 * (va + vb), vb > va);
-                if va != vb {
-                    let sense = if up { 1.0 } else { -1.0 };
-                    let (mut a, mut b) = (lo, hi);
-                    for _ in 0..200 {
-                        let mid = 0.5 * (a + b);
-                        if sense * (cubic.value(mid) - edge) >= 0.0 {
-                            b = mid;
-                        } else {
-                            a = mid;
-                        }
-                    }
-                    let s = cubic.first_at(edge, up, lo, hi);
-                    // The rounding of the cubic's value, and what it leaves of the root.
-                    let size = cubic.a.abs() + cubic.b.abs() + cubic.c.abs() + cubic.d.abs();
-                    let noise = 16.0 * f64::EPSILON * (size + edge.abs());
-                    let miss = cubic.value(s) - edge;
-                    assert!(sense * miss >= 0.0 && miss.abs() <= noise, "{k}: {miss}");
-                    let slope = cubic.rate(b).abs().max(1e-3);
-                    assert!((s - b).abs() <= 2.0 * noise / slope, "{k}: {s} {b}");
-                }
-                lo = hi;
-            }
-        }
     }
 }

@@ -159,12 +159,20 @@ pub(crate) fn reduced_basis(
         _ => shift(model, &k0, cutoff),
     };
     // Unit forces on the element coordinates (the loads need none: see the module's docs).
-    let forces: Vec<Vec<(usize, f64)>> = model
+    let mut forces: Vec<Vec<(usize, f64)>> = model
         .elements()
         .iter()
         .filter(|e| !e.law().is_linear_time_invariant())
         .map(|e| e.weights().to_vec())
         .collect();
+    if r == 0 && forces.is_empty() {
+        // No mode below the cut-off and no element: the loaded DOFs give the basis its
+        // vectors (an empty one would have no multipliers at all).
+        let mut loaded: Vec<usize> = model.loads().iter().map(|l| l.dof).collect();
+        loaded.sort_unstable();
+        loaded.dedup();
+        forces.extend(loaded.into_iter().map(|d| vec![(d, 1.0)]));
+    }
     // The basis is that of the last call if the modes, the shift and the forces are.
     let key = {
         let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -310,5 +318,27 @@ mod tests {
         let relative = |a: f64| (a - exact).abs() / exact.abs();
         assert!(relative(reduced) < 1e-4, "{}", relative(reduced));
         assert!(relative(modes) > 0.5, "{}", relative(modes));
+    }
+
+    /// No mode below the cut-off and no element: the loaded DOF still gives the basis a
+    /// vector (it would have none, and the analysis no multiplier).
+    #[test]
+    fn a_model_without_elements_below_its_first_mode_keeps_the_load() {
+        let n = 10;
+        let names: Vec<String> = (0..n).map(|i| format!("x{i}")).collect();
+        let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+        let k = DMatrix::from_fn(n, n, |i, j| match i.abs_diff(j) {
+            0 => 2.0,
+            1 => -1.0,
+            _ => 0.0,
+        });
+        let model = Model::builder(&refs)
+            .mass_diagonal(&vec![1.0; n])
+            .stiffness(k)
+            .load(refs[n - 1], 1, 1.0, 0.0)
+            .build()
+            .unwrap();
+        let basis = reduced_basis(&model, 0.01, 0.02, &mut ModeCache::default()).unwrap();
+        assert_eq!((basis.modes, basis.attachment, basis.v.ncols()), (0, 1, 1));
     }
 }

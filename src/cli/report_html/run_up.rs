@@ -5,7 +5,8 @@ use super::{document, figure, num, percent, Inputs};
 use crate::cli::report::Part;
 use hbal::report::{significant, HtmlReport};
 
-/// Frequency-response plots shown (of the first DOFs; every one is in `sweep/`).
+/// Frequency-response plots shown (of the first DOFs the sweep wrote plots of, its
+/// `harmonics_dofs`; every one of those is in `sweep/`).
 const FREQUENCY_RESPONSES: usize = 2;
 
 pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
@@ -69,8 +70,18 @@ pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
         "waterfall.svg",
         "Waterfall: the spectrum at each speed",
     );
-    let dofs = i.scene.model.dof_names();
-    for dof in dofs.iter().take(FREQUENCY_RESPONSES) {
+    let written: Vec<&str> = doc["harmonics_dofs"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|v| v.as_str()).collect())
+        .unwrap_or_else(|| {
+            i.scene
+                .model
+                .dof_names()
+                .iter()
+                .map(String::as_str)
+                .collect()
+        });
+    for dof in written.iter().take(FREQUENCY_RESPONSES) {
         figure(
             r,
             &dir,
@@ -78,10 +89,10 @@ pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
             &format!("Frequency response of {dof} (stable solid, unstable dashed)"),
         );
     }
-    if dofs.len() > FREQUENCY_RESPONSES {
+    if written.len() > FREQUENCY_RESPONSES {
         r.paragraph(&format!(
             "The frequency responses of the other {} DOFs are in sweep/.",
-            dofs.len() - FREQUENCY_RESPONSES
+            written.len() - FREQUENCY_RESPONSES
         ));
     }
 }
