@@ -236,7 +236,10 @@ impl FloquetOptions {
             estimate: None,
             comparison_dofs: None,
         };
-        Ok((Coordinates::reduced(model, basis.v), info))
+        Ok((
+            Coordinates::reduced_with(model, basis.v, &basis.projected),
+            info,
+        ))
     }
 
     /// Adds the reduction's estimate to `floquet` (an analysis of `solution` on the reduced

@@ -49,6 +49,9 @@ pub(crate) struct Basis {
     pub(crate) modes: usize,
     /// a, the attachment modes kept.
     pub(crate) attachment: usize,
+    /// `(VᵀMV, VᵀDV, VᵀKV)` of the structure, formed once per basis (a sweep's points share
+    /// it).
+    pub(crate) projected: std::sync::Arc<(DMatrix<f64>, DMatrix<f64>, DMatrix<f64>)>,
 }
 
 /// The modes of `(K0, M)` computed so far for one model (identified by a hash of `K0` and
@@ -222,10 +225,12 @@ pub(crate) fn reduced_basis(
         v.set_column(last, &x);
         kept += 1;
     }
+    let projected = std::sync::Arc::new(super::system::project_structure(model, &v));
     let basis = Basis {
         v,
         modes: r,
         attachment: kept,
+        projected,
     };
     cache.last = Some((key, basis.clone()));
     Ok(basis)

@@ -48,10 +48,17 @@ impl<'m> Coordinates<'m> {
 
     /// The Galerkin projection onto the columns of `v` (n × r).
     pub(crate) fn reduced(model: &'m Model, v: DMatrix<f64>) -> Self {
-        let project = |a: &crate::model::SparseMatrix| {
-            let av = sparse_times(a, &v);
-            v.transpose() * av
-        };
+        let projected = project_structure(model, &v);
+        Self::reduced_with(model, v, &projected)
+    }
+
+    /// [`Coordinates::reduced`] with the structure's `(VᵀMV, VᵀDV, VᵀKV)` already formed
+    /// ([`project_structure`]).
+    pub(crate) fn reduced_with(
+        model: &'m Model,
+        v: DMatrix<f64>,
+        (mass, damping, stiffness): &(DMatrix<f64>, DMatrix<f64>, DMatrix<f64>),
+    ) -> Self {
         let r = v.ncols();
         let dense_weights = |w: &[(usize, f64)]| -> Vec<(usize, f64)> {
             (0..r)
@@ -60,9 +67,9 @@ impl<'m> Coordinates<'m> {
         };
         Self {
             model,
-            mass: project(model.mass()),
-            damping: project(model.structural_damping()),
-            stiffness: project(model.structural_stiffness()),
+            mass: mass.clone(),
+            damping: damping.clone(),
+            stiffness: stiffness.clone(),
             weights: model
                 .elements()
                 .iter()
@@ -126,6 +133,19 @@ impl<'m> Coordinates<'m> {
 }
 
 /// `A V` for a sparse `A` and a dense `V`.
+/// `(VᵀMV, VᵀDV, VᵀKV)` of the model's structure (without its elements) on the basis `v`.
+pub(crate) fn project_structure(
+    model: &Model,
+    v: &DMatrix<f64>,
+) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let project = |a: &crate::model::SparseMatrix| v.transpose() * sparse_times(a, v);
+    (
+        project(model.mass()),
+        project(model.structural_damping()),
+        project(model.structural_stiffness()),
+    )
+}
+
 pub(crate) fn sparse_times(a: &crate::model::SparseMatrix, v: &DMatrix<f64>) -> DMatrix<f64> {
     let mut out = DMatrix::zeros(v.nrows(), v.ncols());
     for j in 0..v.ncols() {
