@@ -18,7 +18,9 @@
 //! `w_eᵀ q_r = (K⁻¹w_e)ᵀ K q_r = (K⁻¹w_e)ᵀ f = w_eᵀ K⁻¹ f` (up to the shift σ). On the
 //! drivetrain (8 loaded DOFs) leaving them out takes the basis from 17 to 13 coordinates and
 //! the stability's work per point down by 30 %; the leading multipliers moved by at most
-//! 4e-5, towards those on the basis with four times the cut-off.
+//! 4e-5, towards those on the basis with four times the cut-off. (A model with no element and
+//! no mode below the cut-off keeps the loads' attachment modes, so that its basis is not
+//! empty.)
 //!
 //! The modes come from a [`ModeCache`], computed once per model up to a reach (by default
 //! twice the cut-off) and selected below each cut-off.
