@@ -19,7 +19,7 @@ pub(crate) fn reported_dofs(model: &Model, spec: Option<&str>) -> anyhow::Result
     let n = names.len();
     let spec = spec.map(str::trim);
     // A whole list that is one DOF's name (a name may hold a comma).
-    if let Some(i) = spec.and_then(|s| names.iter().position(|d| d == s)) {
+    if let Some(i) = spec.and_then(|s| model.dof_index(s)) {
         if spec != Some("all") {
             return Ok(vec![i]);
         }
@@ -32,7 +32,7 @@ pub(crate) fn reported_dofs(model: &Model, spec: Option<&str>) -> anyhow::Result
                 .elements()
                 .iter()
                 .flat_map(|e| e.weights().iter().filter(|(_, w)| *w != 0.0).map(|&(i, _)| i))
-                .chain(model.loads().iter().map(|l| l.dof))
+                .chain(model.loaded_dofs())
                 .collect();
             if touched.is_empty() {
                 touched = (0..n.min(ALL_UP_TO)).collect();
@@ -46,7 +46,7 @@ pub(crate) fn reported_dofs(model: &Model, spec: Option<&str>) -> anyhow::Result
                 if name.is_empty() {
                     anyhow::bail!("--dofs: an empty name in `{list}` (DOF names separated by commas, or `all`)");
                 }
-                names.iter().position(|d| d == name).ok_or_else(|| {
+                model.dof_index(name).ok_or_else(|| {
                     let shown: Vec<&str> = names.iter().take(8).map(String::as_str).collect();
                     anyhow::anyhow!(
                         "--dofs: the model has no DOF named `{name}` (its {n} DOFs: {}{})",

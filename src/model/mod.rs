@@ -88,6 +88,14 @@ impl Model {
         self.dofs.iter().position(|d| d == name)
     }
 
+    /// The DOFs that loads act on, ascending, each once.
+    pub fn loaded_dofs(&self) -> Vec<usize> {
+        let mut dofs: Vec<usize> = self.loads.iter().map(|l| l.dof).collect();
+        dofs.sort_unstable();
+        dofs.dedup();
+        dofs
+    }
+
     /// Mass matrix M.
     pub fn mass(&self) -> &SparseMatrix {
         &self.mass

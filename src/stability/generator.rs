@@ -48,9 +48,7 @@ impl Forcing {
         orders.sort_unstable();
         orders.dedup();
         let states = 2 * orders.len() - 1;
-        let mut dofs: Vec<usize> = model.loads().iter().map(|l| l.dof).collect();
-        dofs.sort_unstable();
-        dofs.dedup();
+        let dofs = model.loaded_dofs();
         let mut dirs = DMatrix::zeros(n, dofs.len());
         let mut c = DMatrix::zeros(dofs.len(), states);
         for (l, dir) in model.loads().iter().zip(&sys.loads) {

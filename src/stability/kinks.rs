@@ -5,7 +5,7 @@
 
 use super::exponential::ExpFlow;
 use super::kernels::gemv;
-use super::pieces::Pieces;
+use super::pieces::{stays_inside, widened, Pieces};
 use super::system::Coordinates;
 use nalgebra::{DMatrix, DVector};
 
@@ -15,8 +15,8 @@ pub(crate) struct Kinked {
     /// `2K × 2n`: row `2j` is `s_q w̃_e` on the positions, row `2j + 1` is `s_v w̃_e` on the
     /// rates, for the `j`-th element with kinks `e`.
     pub(crate) rows: DMatrix<f64>,
-    /// The current piece's edges of each, widened by the crossing's tolerance
-    /// ([`Pieces::crossing`]): a sub-step whose `u` stays inside needs no closer look.
+    /// The current piece's edges of each, [`widened`] by the crossing's tolerance: a sub-step
+    /// whose `u` stays inside needs no closer look.
     bounds: Vec<(f64, f64)>,
 }
 
@@ -46,12 +46,11 @@ impl Kinked {
     }
 
     /// The edges of every element's current piece in `pieces` (after a crossing or a new
-    /// start), widened as [`Pieces::crossing`] widens them.
+    /// start), [`widened`] as [`Pieces::crossing`] widens them.
     pub(crate) fn refresh(&mut self, pieces: &Pieces, scale_q: f64) {
         for (b, &e) in self.bounds.iter_mut().zip(&self.elements) {
             let (lo, hi) = pieces.interval(e);
-            let tol = 1e-13 * (scale_q + lo.abs().min(hi.abs()).min(1e300));
-            *b = (lo - tol, hi + tol);
+            *b = widened(lo, hi, scale_q);
         }
     }
 }
@@ -86,11 +85,10 @@ impl ExpFlow<'_, '_> {
         let mut best: Option<(f64, usize, bool)> = None;
         let pairs = start.chunks_exact(2).zip(end.chunks_exact(2));
         let elements = self.kinks.elements.iter().zip(&self.kinks.bounds);
-        for ((&e, &(lo, hi)), (a, b)) in elements.zip(pairs) {
+        for ((&e, &edges), (a, b)) in elements.zip(pairs) {
             let (u0, du0, u1, du1) = (a[0], a[1], b[0], b[1]);
             // Inside the widened edges with the interpolant's largest overshoot: no crossing.
-            let reach = 0.15 * h.abs() * (du0.abs() + du1.abs());
-            if u0.min(u1) - reach > lo && u0.max(u1) + reach < hi {
+            if stays_inside((u0, u1, du0, du1), h, edges) {
                 continue;
             }
             if let Some((s, up)) = self.pieces.crossing(e, u0, u1, du0, du1, h, self.scale_q) {

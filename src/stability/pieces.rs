@@ -182,17 +182,14 @@ impl Pieces {
         if lo == f64::NEG_INFINITY && hi == f64::INFINITY {
             return None;
         }
-        let tol = 1e-13 * (scale_q + lo.abs().min(hi.abs()).min(1e300));
-        // The interpolant stays within the end values widened by (4/27) h |u̇| at each end
-        // (the largest Hermite basis functions for the rates): no probe needed inside that.
-        let reach = 0.15 * h.abs() * (du0.abs() + du1.abs());
-        if u0.min(u1) - reach > lo - tol && u0.max(u1) + reach < hi + tol {
+        let (low, high) = widened(lo, hi, scale_q);
+        if stays_inside((u0, u1, du0, du1), h, (low, high)) {
             return None;
         }
         let outside = |u: f64| -> Option<bool> {
-            if u >= hi + tol {
+            if u >= high {
                 Some(true)
-            } else if u <= lo - tol {
+            } else if u <= low {
                 Some(false)
             } else {
                 None
@@ -214,6 +211,25 @@ impl Pieces {
         }
         None
     }
+}
+
+/// The edges `(lo, hi)` of a piece widened by the crossing's tolerance `1e-13 (s_q + |kink|)`:
+/// a crossing is counted once `u` is beyond them.
+pub(crate) fn widened(lo: f64, hi: f64, scale_q: f64) -> (f64, f64) {
+    let tol = 1e-13 * (scale_q + lo.abs().min(hi.abs()).min(1e300));
+    (lo - tol, hi + tol)
+}
+
+/// `true` if the cubic Hermite interpolant of `(u0, u1, u̇0, u̇1)` over a step `h` stays
+/// strictly inside the widened edges `(low, high)`: it stays within the end values widened by
+/// (4/27) h |u̇| at each end (the largest Hermite basis functions for the rates).
+pub(crate) fn stays_inside(
+    (u0, u1, du0, du1): (f64, f64, f64, f64),
+    h: f64,
+    (low, high): (f64, f64),
+) -> bool {
+    let reach = 0.15 * h.abs() * (du0.abs() + du1.abs());
+    u0.min(u1) - reach > low && u0.max(u1) + reach < high
 }
 
 /// `Φ̃ ← S Φ̃` for the saltation matrix of a force jump of an element with weights `w̃_e`

@@ -173,10 +173,7 @@ pub(crate) fn reduced_basis(
     if r == 0 && forces.is_empty() {
         // No mode below the cut-off and no element: the loaded DOFs give the basis its
         // vectors (an empty one would have no multipliers at all).
-        let mut loaded: Vec<usize> = model.loads().iter().map(|l| l.dof).collect();
-        loaded.sort_unstable();
-        loaded.dedup();
-        forces.extend(loaded.into_iter().map(|d| vec![(d, 1.0)]));
+        forces.extend(model.loaded_dofs().into_iter().map(|d| vec![(d, 1.0)]));
     }
     // The basis is that of the last call if the modes, the shift and the forces are.
     let key = {
@@ -260,15 +257,7 @@ mod tests {
         let n = 10;
         let names: Vec<String> = (0..n).map(|i| format!("x{i}")).collect();
         let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-        // Springs to the ground at both ends and between neighbours.
-        let k = DMatrix::from_fn(n, n, |i, j| match i.abs_diff(j) {
-            0 => 2.0,
-            1 => -1.0,
-            _ => 0.0,
-        });
-        Model::builder(&refs)
-            .mass_diagonal(&vec![1.0; n])
-            .stiffness(k)
+        grounded_chain(&refs)
             .element(
                 "spring",
                 &[(refs[a], 1.0), (refs[a + 1], -1.0)],
@@ -277,6 +266,19 @@ mod tests {
             .load(refs[n - 1], 1, 1.0, 0.0)
             .build()
             .unwrap()
+    }
+
+    /// Unit masses `refs` on unit springs between neighbours and to the ground at both ends.
+    fn grounded_chain(refs: &[&str]) -> crate::model::ModelBuilder {
+        let n = refs.len();
+        let k = DMatrix::from_fn(n, n, |i, j| match i.abs_diff(j) {
+            0 => 2.0,
+            1 => -1.0,
+            _ => 0.0,
+        });
+        Model::builder(refs)
+            .mass_diagonal(&vec![1.0; n])
+            .stiffness(k)
     }
 
     /// The kept basis is another model's only if the modes, the shift and the elements' unit
@@ -331,18 +333,10 @@ mod tests {
     /// vector (it would have none, and the analysis no multiplier).
     #[test]
     fn a_model_without_elements_below_its_first_mode_keeps_the_load() {
-        let n = 10;
-        let names: Vec<String> = (0..n).map(|i| format!("x{i}")).collect();
+        let names: Vec<String> = (0..10).map(|i| format!("x{i}")).collect();
         let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-        let k = DMatrix::from_fn(n, n, |i, j| match i.abs_diff(j) {
-            0 => 2.0,
-            1 => -1.0,
-            _ => 0.0,
-        });
-        let model = Model::builder(&refs)
-            .mass_diagonal(&vec![1.0; n])
-            .stiffness(k)
-            .load(refs[n - 1], 1, 1.0, 0.0)
+        let model = grounded_chain(&refs)
+            .load(refs[9], 1, 1.0, 0.0)
             .build()
             .unwrap();
         let basis = reduced_basis(&model, 0.01, 0.02, &mut ModeCache::default()).unwrap();
