@@ -73,7 +73,7 @@ const PREDICTED_ORBIT_DISTANCE: f64 = 1e-2;
 
 /// Whether the shooting starts from the start predicted by earlier points, with chord steps on
 /// the previous point's monodromy matrix. It was off while the chord steps along a nearly
-/// singular `Φ − I` (the backlash chain's branch switch, tests/branch_switching.rs) stopped
+/// singular `Φ − I` (the backlash chain's branch switch, tests/integration/branch_switching.rs) stopped
 /// 1.3e-6 from the reference multiplier; the steps ahead and the chord steps are now taken only
 /// while the residual is within 100× of the converged one, and that test passes with it on.
 const PREDICTED_START: bool = true;

@@ -3,7 +3,7 @@
 //! periodic solution equal those of the same scene given densely; every kind of bad input gives
 //! a message naming the file and the line (or the field and the DOF), and exit code 2.
 
-mod common;
+use crate::common;
 
 use common::hbal;
 use hbal::nalgebra::DMatrix;

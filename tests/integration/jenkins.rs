@@ -4,7 +4,7 @@
 //! against finite differences, Newton's iteration counts, the frequency response over NLvib's
 //! range, and points against the time-domain reference (which shows its own convergence).
 
-mod common;
+use crate::common;
 
 use common::time_domain::state_at_zero;
 use hbal::compare::relative_error;

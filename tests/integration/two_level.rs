@@ -1,7 +1,7 @@
 //! The two-level map (Newton's Jacobian on the low harmonics, the per-harmonic step above)
 //! against the plain solvers, the shared reference and a tight time-domain reference.
 
-mod common;
+use crate::common;
 
 use common::reference;
 use hbal::catalog::TwoShaft;

@@ -1,7 +1,7 @@
 //! HB and the time-domain reference against independently computed periodic solutions
 //! (scipy DOP853 + Newton shooting, see ../shared/reference/README.md).
 
-mod common;
+use crate::common;
 
 use common::reference;
 use hbal::catalog::{Duffing, GearBacklash, TwoShaft};

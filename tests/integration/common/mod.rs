@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod floquet;
+pub mod hostile;
 pub mod time_domain;
 
 use num_complex::Complex64;

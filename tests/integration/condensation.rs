@@ -3,7 +3,7 @@
 //! gear meshes (mesh stiffness and backlash on one coordinate each), for Newton and for the
 //! two-level Anderson map.
 
-mod common;
+use crate::common;
 
 use hbal::compare::relative_error;
 use hbal::force::{Backlash, MeshDamping, MeshProfile, MeshStiffness};

@@ -1,7 +1,7 @@
 //! The exit-code contract on every subcommand: 0 success, 1 a numerical failure (results still
 //! written and marked), 2 bad input or an unusable `--out`, found before the work starts.
 
-mod common;
+use crate::common;
 
 use common::hbal;
 use std::path::{Path, PathBuf};

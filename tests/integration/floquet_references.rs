@@ -5,7 +5,7 @@
 //! W = 0.7 and 0.8) and the symmetric 3-DOF backlash chain on both sides of its
 //! symmetry-breaking point. Moduli and complex multipliers within 1e-6.
 
-mod common;
+use crate::common;
 
 use common::floquet::{orbits, reference_multipliers, scene, solve_at};
 use hbal::catalog::GearBacklash;

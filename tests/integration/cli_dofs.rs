@@ -3,7 +3,7 @@
 //! always); a small one every DOF; `all` and a list of names choose; an unknown name is bad
 //! input.
 
-mod common;
+use crate::common;
 
 use common::hbal;
 

@@ -4,7 +4,7 @@
 //! soft ground spring, between the full and condensed formulations, and for the clear error
 //! on unbalanced static loads.
 
-mod common;
+use crate::common;
 
 use hbal::force::{Backlash, LinearSpring, MeshDamping, MeshProfile, MeshStiffness};
 use hbal::harmonic::from_cos_sin;

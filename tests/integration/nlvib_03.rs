@@ -5,7 +5,7 @@
 //! response is continued from Ω = 0.8 down to 0.5 through both turning points; stable points
 //! are checked against the time-domain reference.
 
-mod common;
+use crate::common;
 
 use common::time_domain::state_at_zero;
 use hbal::compare::relative_error;

@@ -2,8 +2,7 @@
 //! bombs refused before any allocation, meaningless fields refused with their field path,
 //! non-finite values stopped where they arise (never printed as `null`, NaN or inf).
 
-#[path = "common/hostile.rs"]
-mod hostile;
+use crate::common::hostile;
 
 use hbal::scene::Scene;
 use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
@@ -377,7 +376,7 @@ fn library_non_finite_errors_name_the_place() {
 
 /// A parameter sweep that meets an undamped resonance keeps its points and exits 1; an
 /// unusable `--out` is refused before the sweep (exit 2). (A DOF name that cannot be part of a
-/// file name is refused: tests/report.rs.)
+/// file name is refused: tests/integration/report.rs.)
 #[test]
 fn parameter_sweep_failures_are_honest() {
     let undamped = "dofs = [\"x1\"]\nmass = [[1.0]]\nstiffness = [[1.0]]\n\

@@ -3,7 +3,7 @@
 //! cancels the orders it should, the fundamental is chosen so that half orders are harmonics,
 //! and bad tables are refused naming the field.
 
-mod common;
+use crate::common;
 
 use hbal::model::{Cylinders, EngineExcitation, EngineOrder};
 use hbal::scene::Scene;

@@ -1,7 +1,7 @@
 //! `hbal sweep --all-branches`: the period-2 orbit of the gear pair's parametric resonance out
 //! of one sweep, with the period doubling located; the bad uses of the flag; automatic harmonics.
 
-mod common;
+use crate::common;
 
 use common::hbal;
 

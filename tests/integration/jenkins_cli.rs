@@ -1,7 +1,7 @@
 //! The `jenkins` law from the command line: bad parameters exit 2 naming the element and the
 //! field; `solve` and `sweep` report stability as not available (laws with memory), exit 0.
 
-mod common;
+use crate::common;
 
 use common::hbal;
 

@@ -3,7 +3,7 @@
 //! a gear stage with a rectangular mesh stiffness; balanced mean torques) against the
 //! time-domain reference at three engine speeds of its 800 - 6000 rpm sweep.
 
-mod common;
+use crate::common;
 
 use common::time_domain::{hb, time_domain_to};
 use hbal::compare::relative_error;

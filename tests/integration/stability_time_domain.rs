@@ -104,6 +104,6 @@ fn stability_labels_agree_with_time_integration_for_every_scene() {
     // From their linear starts these orbits are stable but for one: the chain at its scene
     // speed 1.36, past its branch point, where Newton keeps the symmetry of the linear start
     // and lands on the (unstable) symmetric orbit; time integration agrees. Unstable orbits
-    // are checked against independent references in tests/floquet_references.rs.
+    // are checked against independent references in tests/integration/floquet_references.rs.
     assert!(unstable_seen <= 1, "{unstable_seen} unstable orbits");
 }

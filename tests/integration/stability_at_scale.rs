@@ -2,7 +2,7 @@
 //! matrix: with every mode kept the reduction is a similarity transform (the same multipliers
 //! to 1e-8); with the automatic cut-off its accuracy estimate bounds the true error.
 
-mod common;
+use crate::common;
 
 use common::floquet::{drivetrain, hausdorff, one_way, scene, solve};
 use hbal::stability::{Floquet, FloquetMethod, FloquetOptions};

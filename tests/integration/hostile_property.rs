@@ -9,12 +9,11 @@
 //! list entry dropped, a list
 //! entry duplicated, or a string replaced. The default is a short run (8 cases, a few seconds);
 //! `PROPTEST_CASES=N` sets the number of cases, and
-//! `HOSTILE_SECONDS=600 PROPTEST_CASES=1000000 cargo test --release --test hostile_property --
-//! --nocapture` is the long run: ten minutes (cases after the time budget are skipped), and the
+//! `HOSTILE_SECONDS=600 PROPTEST_CASES=1000000 cargo test --release --test integration --
+//! hostile_property --nocapture` is the long run: ten minutes (cases after the time budget are skipped), and the
 //! summary line reports the cases, runs, exit codes and breaches.
 
-#[path = "common/hostile.rs"]
-mod hostile;
+use crate::common::hostile;
 
 use hostile::{judge, run_limited, write, Breach};
 use proptest::prelude::*;

@@ -4,7 +4,7 @@
 //! other laws; the reduction's estimate with the comparison's shortened shooting; and the
 //! [`FloquetCache`] of a sweep.
 
-mod common;
+use crate::common;
 
 use common::floquet::{
     coarse_drivetrain, drivetrain, hausdorff, orbits, reference_multipliers, scene, solve_at,

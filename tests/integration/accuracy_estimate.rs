@@ -1,7 +1,7 @@
 //! The error estimate against the true error (independent references), and the automatic
 //! choice of H against the shared references at tolerance 1e-6.
 
-mod common;
+use crate::common;
 
 use common::reference;
 use hbal::catalog::{Duffing, GearBacklash, TwoShaft};

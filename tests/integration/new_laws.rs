@@ -4,7 +4,7 @@
 //! periods agree to 1e-11). The error is [`relative_error`] over harmonics 0..=2H (the HB
 //! solution has none above H, so its truncation counts).
 
-mod common;
+use crate::common;
 
 use common::time_domain::{error_against_time_domain, hb};
 use hbal::num_complex::Complex64;

@@ -3,7 +3,7 @@
 //! on closed-form static solutions, its equality with the generic mesh element it builds, and
 //! its bad input.
 
-mod common;
+use crate::common;
 
 use hbal::force::{MeshDamping, MeshProfile, MeshStiffness};
 use hbal::model::GearStage;

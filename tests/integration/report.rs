@@ -2,7 +2,7 @@
 //! from the network, and renders in a real browser (headless Chromium, where one is installed;
 //! CI installs one and sets `HBAL_REQUIRE_BROWSER=1`). Bad input is refused before any work.
 
-mod common;
+use crate::common;
 
 use common::hbal;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! The `hbal` binary on every example scene and on a catalogue of broken scenes, each with the
 //! message it must show and exit code 2.
 
-mod common;
+use crate::common;
 
 use common::hbal;
 

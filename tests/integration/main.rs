@@ -1,0 +1,52 @@
+//! The integration tests, one module per topic, in one test binary: one link instead of 42 (a
+//! fresh test build is about a minute shorter, and the binaries took 2 GB of disk). The
+//! allocation count (`tests/no_allocation.rs`) keeps a binary of its own: it installs a global
+//! allocator.
+//!
+//! One topic: `cargo test --test integration -- continuation::`; the heavy cases run in release
+//! with `--ignored` (see `.ci/run`).
+
+mod common;
+
+mod accuracy_estimate;
+mod aft;
+mod bad_input;
+mod band_limited;
+mod branch_switching;
+mod cli;
+mod cli_branches;
+mod cli_dofs;
+mod condensation;
+mod continuation;
+mod drivetrain;
+mod element_output;
+mod engine;
+mod exit_codes;
+mod floquet_references;
+mod force_laws;
+mod free_free;
+mod free_free_time_domain;
+mod gear_stage;
+mod hard_cases;
+mod hostile_input;
+mod hostile_property;
+mod jacobian;
+mod jenkins;
+mod jenkins_cli;
+mod kink_quadrature;
+mod linear;
+mod matrix_import;
+mod modes;
+mod new_laws;
+mod nlvib_03;
+mod order_cuts;
+mod reference_solutions;
+mod report;
+mod scene_export;
+mod stability_at_scale;
+mod stability_exponential;
+mod stability_time_domain;
+mod stability_worker;
+mod tail_correction;
+mod threads;
+mod two_level;
