@@ -1,6 +1,7 @@
 //! Order cuts of a speed sweep: for every point of the branch, the amplitude and phase of each
 //! excitation order (the scene's load orders and mesh orders, as multiples of the reference
-//! speed) of every DOF (up to 50 DOFs) and every element coordinate, and the fraction of the
+//! speed) of the reported DOFs (`--dofs`, [`super::dof_selection`]) and every element
+//! coordinate, and the fraction of the
 //! period each contact spends open: `order_cuts.csv`; for one chosen output (`--output`, by
 //! default the first gear stage's transmission error, else the DOF that moves most) the order
 //! cuts `order_cuts.svg` and the waterfall of its spectrum over speed `waterfall.svg`.
@@ -12,9 +13,6 @@ use hbal::report::{
 use hbal::scene::Scene;
 use hbal::{HarmonicBasis, Solution};
 use std::path::Path;
-
-/// Most DOFs with columns of their own in `order_cuts.csv`.
-const MAX_DOF_COLUMNS: usize = 50;
 
 /// The output the order-cut plot and the waterfall show.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -130,26 +128,36 @@ fn shown_amplitude<'a>(
     }
 }
 
+/// What the order cuts show: the DOFs with columns in `order_cuts.csv` (indices into
+/// `branch.dofs`; every element has its own) and the output of the plots.
+pub(crate) struct Shows<'a> {
+    pub(crate) dofs: &'a [usize],
+    pub(crate) plotted: Shown,
+}
+
 /// Writes `order_cuts.csv`, `order_cuts.svg` and `waterfall.svg` for `branch` (computed on
-/// `basis`) into `dir`, the plots of `shown`.
+/// `basis`) into `dir`: the columns and plots of `shows`.
 pub(crate) fn write(
     dir: &Path,
     scene: &Scene,
     branch: &Branch,
     basis: &HarmonicBasis,
     outputs: &[Vec<ElementOutput>],
-    shown: Shown,
+    shows: Shows,
     speed: impl Fn(f64) -> f64,
 ) -> anyhow::Result<()> {
+    let Shows {
+        dofs,
+        plotted: shown,
+    } = shows;
     let orders = super::excitation_orders(scene, basis);
     let n = branch.dofs.len();
     let mut w = csv::Writer::from_path(dir.join("order_cuts.csv"))?;
     let mut header = vec![scene.speed_unit.to_string()];
-    // Every DOF of a model of at most MAX_DOF_COLUMNS DOFs (a large model: its elements only).
-    let dof_columns = if n <= MAX_DOF_COLUMNS { n } else { 0 };
-    let names: Vec<String> = branch.dofs[..dof_columns]
+    let dof_columns = dofs.len();
+    let names: Vec<String> = dofs
         .iter()
-        .cloned()
+        .map(|&i| branch.dofs[i].clone())
         .chain(
             scene
                 .model
@@ -183,7 +191,7 @@ pub(crate) fn write(
         let mut row = vec![format!("{:e}", speed(p.omega))];
         let harmonic_of = |name: usize, k: usize| {
             if name < dof_columns {
-                p.harmonics[k * n + name]
+                p.harmonics[k * n + dofs[name]]
             } else {
                 outputs[name - dof_columns].coordinate.harmonics[k]
             }

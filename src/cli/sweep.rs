@@ -306,7 +306,18 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 speed,
             ),
         )?;
-        super::order_cuts::write(dir, &scene, &branch, &basis, &outputs, shown, speed)?;
+        super::order_cuts::write(
+            dir,
+            &scene,
+            &branch,
+            &basis,
+            &outputs,
+            super::order_cuts::Shows {
+                dofs: &reported,
+                plotted: shown,
+            },
+            speed,
+        )?;
         for (i, b) in secondary.iter().enumerate() {
             std::fs::write(
                 dir.join(format!("branch_{}.csv", i + 1)),

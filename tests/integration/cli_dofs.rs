@@ -71,6 +71,11 @@ fn a_large_model_reports_the_dofs_of_its_elements_and_loads() {
     assert_eq!(count("amp_"), 15 * 33);
     assert_eq!(count("amp_throw1_k"), 33);
     assert_eq!(count("amp_input.1_k"), 0);
+    // order_cuts.csv: the same 15 DOFs (and every element).
+    let cuts = std::fs::read_to_string(dir.join("order_cuts.csv")).unwrap();
+    let cut_header = cuts.lines().next().unwrap();
+    assert!(cut_header.contains("amp_throw1_order_"), "{cut_header}");
+    assert!(!cut_header.contains("amp_input.1_order_"), "{cut_header}");
     let plots = std::fs::read_dir(&dir)
         .unwrap()
         .filter(|e| {
