@@ -161,6 +161,67 @@ impl Envelope {
             }
         }
         let work = &mut work[..n * columns];
+        // A row of up to 8 columns is held in registers (the condensation solves m + 2
+        // columns); the same operations in the same order as the general loop.
+        match columns {
+            1 => self.substitute::<1>(values, work),
+            2 => self.substitute::<2>(values, work),
+            3 => self.substitute::<3>(values, work),
+            4 => self.substitute::<4>(values, work),
+            5 => self.substitute::<5>(values, work),
+            6 => self.substitute::<6>(values, work),
+            7 => self.substitute::<7>(values, work),
+            8 => self.substitute::<8>(values, work),
+            _ => self.substitute_any(values, work, columns),
+        }
+        for (new, &old) in self.perm.iter().enumerate() {
+            for c in 0..columns {
+                x[c * n + old] = work[new * columns + c];
+            }
+        }
+    }
+
+    /// `L D Lᵀ` substitution on `work` (row-major, `C` columns), each row in an array.
+    fn substitute<const C: usize>(&self, values: &[Complex64], work: &mut [Complex64]) {
+        let n = self.first.len();
+        let row_of = |work: &[Complex64], i: usize| -> [Complex64; C] {
+            std::array::from_fn(|c| work[i * C + c])
+        };
+        // L y = b: row i takes the finished rows k < i of its envelope.
+        for i in 0..n {
+            let (fi, si) = (self.first[i], self.start[i]);
+            let mut row = row_of(work, i);
+            for (k, l) in (fi..i).zip(&values[si..si + (i - fi)]) {
+                let src = row_of(work, k);
+                for c in 0..C {
+                    row[c] -= l * src[c];
+                }
+            }
+            work[i * C..(i + 1) * C].copy_from_slice(&row);
+        }
+        // D z = y.
+        for (i, row) in work.chunks_exact_mut(C).enumerate() {
+            let inv = values[self.start[i] + (i - self.first[i])];
+            for r in row.iter_mut() {
+                *r *= inv;
+            }
+        }
+        // Lᵀ x = z, from the last row: row i, final, updates the rows k < i of its envelope.
+        for i in (0..n).rev() {
+            let (fi, si) = (self.first[i], self.start[i]);
+            let row = row_of(work, i);
+            for (k, l) in (fi..i).zip(&values[si..si + (i - fi)]) {
+                let dst = &mut work[k * C..(k + 1) * C];
+                for c in 0..C {
+                    dst[c] -= l * row[c];
+                }
+            }
+        }
+    }
+
+    /// [`Self::substitute`] for any number of columns.
+    fn substitute_any(&self, values: &[Complex64], work: &mut [Complex64], columns: usize) {
+        let n = self.first.len();
         // L y = b: row i takes the finished rows k < i of its envelope.
         for i in 0..n {
             let (fi, si) = (self.first[i], self.start[i]);
@@ -196,11 +257,6 @@ impl Envelope {
                 for (d, v) in dst.iter_mut().zip(row) {
                     *d -= l * v;
                 }
-            }
-        }
-        for (new, &old) in self.perm.iter().enumerate() {
-            for c in 0..columns {
-                x[c * n + old] = work[new * columns + c];
             }
         }
     }
@@ -244,6 +300,34 @@ mod tests {
         for i in 0..n {
             let ax: Complex64 = (0..n).map(|j| a[i][j] * x[j]).sum();
             assert!((ax - b[i]).norm() < 1e-13, "row {i}: {ax} vs {}", b[i]);
+        }
+        // Every width of the register-held rows gives the general loop's bits, column by
+        // column the one-column solve's answer.
+        for columns in 1..=9 {
+            let rhs: Vec<Complex64> = (0..n * columns)
+                .map(|i| Complex64::new((i % 7) as f64 - 2.5, 0.25 * (i % 3) as f64))
+                .collect();
+            let mut fast = rhs.clone();
+            let mut work = vec![Complex64::default(); n * columns];
+            env.solve(&values, &mut fast, columns, &mut work);
+            let mut general = rhs.clone();
+            for (new, &old) in env.perm.iter().enumerate() {
+                for c in 0..columns {
+                    work[new * columns + c] = general[c * n + old];
+                }
+            }
+            env.substitute_any(&values, &mut work, columns);
+            for (new, &old) in env.perm.iter().enumerate() {
+                for c in 0..columns {
+                    general[c * n + old] = work[new * columns + c];
+                }
+            }
+            assert_eq!(fast, general, "{columns} columns");
+            for c in 0..columns {
+                let mut one = rhs[c * n..(c + 1) * n].to_vec();
+                env.solve(&values, &mut one, 1, &mut work);
+                assert_eq!(one, fast[c * n..(c + 1) * n], "column {c} of {columns}");
+            }
         }
     }
 
