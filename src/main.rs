@@ -101,8 +101,8 @@ enum Command {
         /// Largest continuation step (scaled arclength; smaller gives more points).
         #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
         max_step: f64,
-        /// The DOFs whose harmonics (branch.csv; a speed sweep's JSON) and response plots are
-        /// written: comma-separated names, or `all` (default: every DOF up to 64, else the DOFs
+        /// The DOFs whose harmonics (branch.csv; a speed sweep's JSON and order_cuts.csv) and
+        /// response plots are written: comma-separated names, or `all` (default: every DOF up to 64, else the DOFs
         /// that elements and loads act on; max |q| of every DOF is always written).
         #[arg(long, value_name = "NAMES")]
         dofs: Option<String>,

@@ -1,5 +1,6 @@
 //! Which DOFs a sweep reports in full, `--dofs`: their harmonics in branch.csv and in the JSON
-//! points, and a response plot each. `max |q|` of every DOF is always written.
+//! points, their order cuts in order_cuts.csv, and a response plot each. `max |q|` of every
+//! DOF is always written.
 //!
 //! A discretised shaft has hundreds of DOFs whose harmonics say little one by one: the
 //! drivetrain of 1000 DOFs wrote a 448 MB branch.csv and a thousand plots for a 604-point

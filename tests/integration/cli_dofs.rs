@@ -71,11 +71,38 @@ fn a_large_model_reports_the_dofs_of_its_elements_and_loads() {
     assert_eq!(count("amp_"), 15 * 33);
     assert_eq!(count("amp_throw1_k"), 33);
     assert_eq!(count("amp_input.1_k"), 0);
-    // order_cuts.csv: the same 15 DOFs (and every element).
+    // order_cuts.csv: the same 15 DOFs (and every element), each order's amplitude the one
+    // branch.csv has for that DOF and order.
     let cuts = std::fs::read_to_string(dir.join("order_cuts.csv")).unwrap();
-    let cut_header = cuts.lines().next().unwrap();
-    assert!(cut_header.contains("amp_throw1_order_"), "{cut_header}");
-    assert!(!cut_header.contains("amp_input.1_order_"), "{cut_header}");
+    let cut_header: Vec<&str> = cuts.lines().next().unwrap().split(',').collect();
+    assert!(!cut_header
+        .iter()
+        .any(|h| h.starts_with("amp_input.1_order_")));
+    assert!(cut_header.iter().any(|h| h.starts_with("amp_u(")));
+    let first_row = |text: &str| -> Vec<f64> {
+        let line = text.lines().nth(1).unwrap();
+        line.split(',')
+            .map(|v| v.parse().unwrap_or(f64::NAN))
+            .collect()
+    };
+    let (cut_row, branch_row) = (first_row(&cuts), first_row(&csv));
+    let mut compared = 0;
+    for (c, name) in cut_header.iter().enumerate() {
+        let Some(order) = name.strip_prefix("amp_throw1_order_") else {
+            continue;
+        };
+        let b = header
+            .iter()
+            .position(|h| h.starts_with("amp_throw1_k") && h.ends_with(&format!("_order_{order}")))
+            .unwrap_or_else(|| panic!("order {order} of throw1 in branch.csv"));
+        let (x, y) = (cut_row[c], branch_row[b]);
+        assert!(
+            (x - y).abs() <= 1e-12 * y.abs(),
+            "order {order}: {x} vs {y}"
+        );
+        compared += 1;
+    }
+    assert!(compared >= 2, "{compared} orders of throw1 compared");
     let plots = std::fs::read_dir(&dir)
         .unwrap()
         .filter(|e| {

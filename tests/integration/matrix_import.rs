@@ -634,7 +634,7 @@ fn cli_solves_the_example_and_refuses_bad_files_with_exit_code_2() {
 }
 
 /// A 1000-DOF chain from Matrix Market files and generated names: read and built quickly
-/// (the time is printed; `cargo test --release --test matrix_import -- --nocapture`).
+/// (the time is printed; `cargo test --release --test integration -- matrix_import:: --nocapture`).
 #[test]
 fn a_thousand_dof_chain_reads_quickly() {
     let n = 1000;

@@ -268,7 +268,7 @@ fn the_sweep_cache_gives_the_fresh_answer() {
 
 /// The 1000-DOF drivetrain scene (4 rectangular meshes, 4 tip-relief contacts, clutch): the
 /// exponential flow against Runge–Kutta, both shootings polished to 1e-10. About 10 s in
-/// release (`cargo test --release --test stability_exponential -- --ignored`).
+/// release (`cargo test --release --test integration -- --ignored stability_exponential::`).
 #[test]
 #[ignore]
 fn the_large_scene_against_runge_kutta() {

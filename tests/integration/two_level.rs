@@ -104,7 +104,7 @@ fn highest_natural_frequency_of_a_chain() {
 /// At 60 rpm the resonance sits at harmonic 771: the Newton block must reach 1.5 ω_max / Ω =
 /// 1156 harmonics (2313 real unknowns, above the automatic choice's cap: 1.2 s, nearly all
 /// its dense factorisation), and H = 2048 then matches a time-domain reference to 1e-5
-/// (measured 5.9e-6). Release build: `cargo test --release --test two_level -- --ignored`.
+/// (measured 5.9e-6). Release build: `cargo test --release --test integration -- --ignored two_level::`.
 #[test]
 #[ignore = "1.2 s in release: run by CI with --ignored"]
 fn two_level_map_at_60_rpm_reaches_1e5() {
