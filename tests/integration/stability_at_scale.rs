@@ -78,8 +78,8 @@ fn check_every_mode_kept(cases: Vec<(&str, Model, Solution)>) {
 /// The drivetrain at n = 100 (coarse teeth, H = 8, 6000 rpm): the automatic cut-off keeps about
 /// a fifth of the coordinates; the estimate (against twice the cut-off) must bound the true
 /// distance to the dense multipliers within a factor 3, and both say the same about stability.
-/// About a minute in release (`cargo test --release --test integration -- --ignored stability_at_scale::`,
-/// run by CI).
+/// Under a second in release (`cargo test --release --test integration -- --ignored
+/// stability_at_scale::`, run by CI; a minute before the exponential flow).
 #[test]
 #[ignore]
 fn the_estimate_of_the_cut_off_basis_is_truthful() {
