@@ -1,4 +1,4 @@
-//! The integration tests, one module per topic, in one test binary: one link instead of 42 (a
+//! The integration tests, one module per topic, in one test binary: one link instead of 42 files (a
 //! fresh test build is about a minute shorter, and the binaries took 2 GB of disk). The
 //! allocation count (`tests/no_allocation.rs`) keeps a binary of its own: it installs a global
 //! allocator.
@@ -15,7 +15,10 @@ mod band_limited;
 mod branch_switching;
 mod cli;
 mod cli_branches;
+mod cli_broken_scenes;
 mod cli_dofs;
+mod cli_start_files;
+mod cli_sweep;
 mod condensation;
 mod continuation;
 mod drivetrain;
