@@ -39,6 +39,7 @@ mod jenkins_cli;
 mod kink_quadrature;
 mod linear;
 mod matrix_import;
+mod matrix_import_bad_input;
 mod modes;
 mod new_laws;
 mod nlvib_03;
