@@ -98,7 +98,9 @@ pub(crate) struct SolverArgs {
     #[arg(long)]
     pub(crate) method: Option<String>,
     /// Number of harmonics H, or `auto` to raise H until the estimated error is below the
-    /// scene's `harmonics.tolerance` (default 1e-6) (default: the scene's).
+    /// scene's `harmonics.tolerance` (default 1e-6) (default: the scene's). `auto:harmonics`
+    /// controls the error of the harmonics 0..H alone (order amplitudes), `auto:solution` that
+    /// of the periodic solution with the harmonics it lacks (the default).
     #[arg(long)]
     pub(crate) harmonics: Option<HarmonicsArg>,
     /// Number of time samples N per period, at least 2H+1 (default: the scene's, or the
@@ -114,22 +116,28 @@ pub(crate) struct SolverArgs {
     pub(crate) formulation: hbal::Formulation,
 }
 
-/// `--harmonics`: a number, or `auto`.
+/// `--harmonics`: a number, or `auto` (with what it controls, else the scene's choice).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum HarmonicsArg {
-    Auto,
+    Auto(Option<hbal::solve::Control>),
     Count(usize),
 }
 
 impl std::str::FromStr for HarmonicsArg {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        if s == "auto" {
-            return Ok(HarmonicsArg::Auto);
+        use hbal::solve::Control;
+        match s {
+            "auto" => return Ok(HarmonicsArg::Auto(None)),
+            "auto:solution" => return Ok(HarmonicsArg::Auto(Some(Control::Solution))),
+            "auto:harmonics" => return Ok(HarmonicsArg::Auto(Some(Control::Harmonics))),
+            _ => {}
         }
-        s.parse::<usize>()
-            .map(HarmonicsArg::Count)
-            .map_err(|_| format!("expected a whole number of harmonics or `auto`, got `{s}`"))
+        s.parse::<usize>().map(HarmonicsArg::Count).map_err(|_| {
+            format!(
+                "expected a whole number of harmonics, `auto`, `auto:harmonics` or `auto:solution`, got `{s}`"
+            )
+        })
     }
 }
 
@@ -170,10 +178,12 @@ pub(crate) fn load(path: &Path, args: &SolverArgs) -> Result<Scene, Failure> {
         auto.formulation = args.formulation;
     }
     match args.harmonics {
-        Some(HarmonicsArg::Auto) => {
+        Some(HarmonicsArg::Auto(control)) => {
+            let auto = scene.auto.unwrap_or_default();
             scene.auto = Some(hbal::solve::AutoHarmonics {
                 formulation: args.formulation,
-                ..scene.auto.unwrap_or_default()
+                control: control.unwrap_or(auto.control),
+                ..auto
             })
         }
         Some(HarmonicsArg::Count(_)) => scene.auto = None,

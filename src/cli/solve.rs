@@ -151,12 +151,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             "truncation_estimate": sol.truncation_estimate(),
             "error_estimate": match &estimate {
                 None => serde_json::Value::Null,
-                Some(Ok(e)) => json!({"relative": e.relative, "reference_harmonics": e.reference_harmonics}),
+                Some(Ok(e)) => json!({"relative": e.relative, "kept_harmonics": e.kept_harmonics, "reference_harmonics": e.reference_harmonics}),
                 Some(Err(e)) => json!({"error": e}),
             },
             "auto_harmonics": auto.as_ref().map(|(a, levels, capped)| json!({
                 "tolerance": a.tolerance,
                 "max": a.max_harmonics,
+                "control": a.control,
                 "reached": !capped,
                 "levels": levels,
             })),
@@ -193,8 +194,11 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             sol.basis().samples(),
             match &estimate {
                 Some(Ok(e)) => format!(
-                    "error estimate {:.1e} (against H = {})",
-                    e.relative, e.reference_harmonics
+                    "error estimate {:.1e}, of harmonics 0..{} {:.1e} (against H = {})",
+                    e.relative,
+                    sol.basis().harmonics(),
+                    e.kept_harmonics,
+                    e.reference_harmonics
                 ),
                 Some(Err(e)) => format!("no error estimate: {e}"),
                 None => "no error estimate (not converged)".to_string(),
@@ -206,8 +210,12 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 .map(|l| format!("H = {} → {:.1e}", l.harmonics, l.estimate))
                 .collect();
             say!(
-                "  harmonics: auto, tolerance {:.0e}{}: {}",
+                "  harmonics: auto, tolerance {:.0e} on {}{}: {}",
                 a.tolerance,
+                match a.control {
+                    hbal::solve::Control::Solution => "the periodic solution",
+                    hbal::solve::Control::Harmonics => "the harmonics 0..H",
+                },
                 if *capped { " (NOT reached)" } else { "" },
                 steps.join(", ")
             );

@@ -4,7 +4,8 @@ use crate::solve::AutoHarmonics;
 use crate::HarmonicBasis;
 use serde::Deserialize;
 
-/// `count` = H, `samples` = N, `auto`, `tolerance`, `max`, `tail_correction` (docs/scenes.md).
+/// `count` = H, `samples` = N, `auto`, `tolerance`, `max`, `control`, `tail_correction`
+/// (docs/scenes.md).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct Harmonics {
@@ -14,6 +15,8 @@ pub(super) struct Harmonics {
     auto: bool,
     tolerance: Option<f64>,
     max: Option<usize>,
+    /// What `auto` controls: `"solution"` (default) or `"harmonics"`.
+    control: Option<crate::solve::Control>,
     /// The tail correction of jumping coefficients (default on, see
     /// [`HarmonicBasis::with_tail_correction`]).
     tail_correction: Option<bool>,
@@ -70,12 +73,14 @@ impl Harmonics {
             Some(AutoHarmonics {
                 tolerance,
                 max_harmonics,
+                control: hs.control.unwrap_or_default(),
                 ..Default::default()
             })
         } else {
             for (field, given) in [
                 ("tolerance", hs.tolerance.is_some()),
                 ("max", hs.max.is_some()),
+                ("control", hs.control.is_some()),
             ] {
                 if given {
                     return Err(fail(

@@ -18,7 +18,9 @@ mod problem;
 mod run;
 mod start;
 
-pub use accuracy::{estimate_error, solve_auto, AutoHarmonics, AutoSolution, ErrorEstimate, Level};
+pub use accuracy::{
+    estimate_error, solve_auto, AutoHarmonics, AutoSolution, Control, ErrorEstimate, Level,
+};
 pub use anderson::{Anderson, AndersonSolver};
 pub use broyden::{Broyden, BroydenSolver, InitialJacobian};
 pub use fixed_point::{FixedPoint, FixedPointSolver};

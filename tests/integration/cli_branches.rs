@@ -215,6 +215,31 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
         std::fs::write(&p, text).unwrap();
         hbal(&["solve", p.to_str().unwrap(), "--no-stability"])
     };
+    // The harmonics 0..H controlled (scene field and --harmonics): the JSON says so and its
+    // kept-harmonics estimate is within the tolerance.
+    for (harmonics, extra) in [
+        (
+            "harmonics = { auto = true, count = 4, control = \"harmonics\" }",
+            None,
+        ),
+        ("harmonics = { count = 4 }", Some("auto:harmonics")),
+    ] {
+        let text = std::fs::read_to_string(&backlash)
+            .unwrap()
+            .replace("harmonics = { count = 7 }", harmonics);
+        let p = dir.join("kept.toml");
+        std::fs::write(&p, text).unwrap();
+        let mut args = vec!["solve", p.to_str().unwrap(), "--no-stability", "--json"];
+        if let Some(h) = extra {
+            args.extend(["--harmonics", h]);
+        }
+        let out = hbal(&args);
+        assert_eq!(out.status.code(), Some(0), "{harmonics} {extra:?}");
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(doc["auto_harmonics"]["control"], "harmonics");
+        let kept = doc["error_estimate"]["kept_harmonics"].as_f64().unwrap();
+        assert!((1e-15..=1e-6).contains(&kept), "{kept}");
+    }
     // A cap below what the tolerance needs: the last level, exit 1 and a message.
     let out = scene("harmonics = { auto = true, count = 1, tolerance = 1e-12, max = 2 }");
     assert_eq!(out.status.code(), Some(1));
@@ -245,6 +270,14 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
         (
             "harmonics = { auto = true, max = 9000000000 }",
             "harmonics.max",
+        ),
+        (
+            "harmonics = { auto = true, control = \"orders\" }",
+            "harmonics.control",
+        ),
+        (
+            "harmonics = { count = 7, control = \"harmonics\" }",
+            "harmonics.control",
         ),
     ] {
         let out = scene(bad);
