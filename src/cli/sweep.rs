@@ -117,10 +117,14 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             .map_err(|e| super::failure(e, &scene.file))?;
         basis = *a.solution.basis();
         eprintln!(
-            "note: harmonics: auto, tolerance {:.0e}: H = {} (error estimate {:.1e} at {from} {unit}{}), kept along the branch",
+            "note: harmonics: auto, tolerance {:.0e}{}: H = {} (error estimate {:.1e} at {from} {unit}{}), kept along the branch",
             auto.tolerance,
+            match auto.control {
+                hbal::solve::Control::Solution => "",
+                hbal::solve::Control::Harmonics => " on the harmonics 0..H",
+            },
             basis.harmonics(),
-            a.estimate.relative,
+            auto.control.of(&a.estimate),
             if a.capped { ", above the tolerance at the cap" } else { "" }
         );
     }
@@ -262,9 +266,15 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             .filter_map(|p| p.error_estimate.map(|e| (e, p.omega)))
             .max_by(|a, b| a.0.total_cmp(&b.0));
         if let Some((e, w)) = worst {
+            let kept = branch
+                .points
+                .iter()
+                .filter_map(|p| p.error_estimate_harmonics)
+                .fold(f64::NAN, f64::max);
             say!(
-                "  largest error estimate {e:.1e} (at {:.6} {unit}; against 2H = {})",
+                "  largest error estimate {e:.1e} (at {:.6} {unit}), of harmonics 0..{} {kept:.1e} (against 2H = {})",
                 speed(w),
+                branch.harmonics,
                 2 * branch.harmonics
             );
         }
@@ -367,10 +377,14 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     }
     // Automatic harmonics chose H at the first speed: say so if the branch needs more.
     if let Some(auto) = scene.auto {
+        let controlled = |p: &hbal::continuation::BranchPoint| match auto.control {
+            hbal::solve::Control::Solution => p.error_estimate,
+            hbal::solve::Control::Harmonics => p.error_estimate_harmonics,
+        };
         let worst = branch
             .points
             .iter()
-            .filter_map(|p| p.error_estimate.map(|e| (e, p.omega)))
+            .filter_map(|p| controlled(p).map(|e| (e, p.omega)))
             .max_by(|a, b| a.0.total_cmp(&b.0));
         if let Some((e, w)) = worst.filter(|(e, _)| *e > auto.tolerance) {
             eprintln!(

@@ -55,6 +55,10 @@ pub struct BranchPoint {
     /// ([`Continuation::error_estimate`]).
     #[serde(default)]
     pub error_estimate: Option<f64>,
+    /// The same for its harmonics `0..=H` alone
+    /// ([`ErrorEstimate::kept_harmonics`](crate::solve::ErrorEstimate::kept_harmonics)).
+    #[serde(default)]
+    pub error_estimate_harmonics: Option<f64>,
     /// Floquet multipliers, if computed.
     pub floquet: Option<Floquet>,
     /// A turning point of the branch lies between the previous point and this one, confirmed

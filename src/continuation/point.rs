@@ -117,12 +117,13 @@ impl Continuation {
         };
         let max_abs = p.max_abs.unwrap_or_else(|| sol.max_abs_all());
         let truncation = sol.truncation_estimate();
-        let error_estimate = self
+        let estimate = self
             .error_estimate
             .then(|| crate::solve::estimate_error(model, &sol).ok())
-            .flatten()
-            .map(|e| e.relative)
-            .filter(|e| e.is_finite());
+            .flatten();
+        let finite = |e: f64| Some(e).filter(|e| e.is_finite());
+        let error_estimate = estimate.and_then(|e| finite(e.relative));
+        let error_estimate_harmonics = estimate.and_then(|e| finite(e.kept_harmonics));
         let residual = sol.residual();
         branch.points.push(BranchPoint {
             parameter: p.parameter,
@@ -132,6 +133,7 @@ impl Continuation {
             residual,
             truncation,
             error_estimate,
+            error_estimate_harmonics,
             floquet,
             // Set by the caller for a turn, then [`classify_turns`] decides once the
             // neighbours are known.

@@ -61,6 +61,7 @@ pub fn branch_csv_of_dofs(
             "spurious_turn",
             "bifurcation_speed",
             "error_estimate",
+            "error_estimate_harmonics",
         ]
         .iter()
         .map(|s| s.to_string()),
@@ -105,11 +106,9 @@ pub fn branch_csv_of_dofs(
                 .map(|w| format!("{:e}", parameter(w)))
                 .unwrap_or_default(),
         );
-        row.push(
-            p.error_estimate
-                .map(|e| format!("{e:e}"))
-                .unwrap_or_default(),
-        );
+        for e in [p.error_estimate, p.error_estimate_harmonics] {
+            row.push(e.map(|e| format!("{e:e}")).unwrap_or_default());
+        }
         let _ = w.write_record(&row);
     }
     String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()

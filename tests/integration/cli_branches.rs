@@ -73,11 +73,14 @@ fn all_branches_finds_the_period_two_orbit() {
         .lines()
         .next()
         .unwrap()
-        .ends_with("bifurcation_speed,error_estimate"));
-    // Every point carries its error estimate (against 2H).
+        .ends_with("bifurcation_speed,error_estimate,error_estimate_harmonics"));
+    // Every point carries its error estimates (against 2H); its harmonics 0..H are at most
+    // as far off as the whole periodic solution.
     for p in points {
         let e = p["error_estimate"].as_f64().unwrap();
         assert!((1e-15..1e-2).contains(&e), "{e}");
+        let kept = p["error_estimate_harmonics"].as_f64().unwrap();
+        assert!((1e-15..=e).contains(&kept), "{kept} vs {e}");
     }
     assert_eq!(csv.lines().count(), points.len() + 1);
     let svg = std::fs::read_to_string(dir.join("frequency_response_x.svg")).unwrap();

@@ -37,7 +37,7 @@ fn sweep_follows_the_backlash_branch_through_its_folds() {
     assert!(csv
         .starts_with("rad_s,stable,fold,bifurcation,max_abs_x,amp_x_k0_order_0,amp_x_k1_order_1"));
     assert!(csv.lines().next().unwrap().ends_with(
-        ",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed,error_estimate"
+        ",multipliers_abs,residual,truncation,fold_speed,spurious_turn,bifurcation_speed,error_estimate,error_estimate_harmonics"
     ));
     assert!(dir.join("frequency_response_x.svg").exists());
     let out = hbal(&["sweep", scene.to_str().unwrap(), "--from=-1", "--to", "1.6"]);
