@@ -322,8 +322,12 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let capped = matches!(&auto, Some((_, _, true)));
     if let Some((a, levels, true)) = &auto {
         eprintln!(
-            "error: {}: automatic harmonics: the estimated error {:.1e} is above the tolerance {:.0e} at the cap H = {} (harmonics.max)",
+            "error: {}: automatic harmonics: the estimated error{} {:.1e} is above the tolerance {:.0e} at the cap H = {} (harmonics.max)",
             scene.file,
+            match a.control {
+                hbal::solve::Control::Solution => " of the periodic solution",
+                hbal::solve::Control::Harmonics => " of the harmonics 0..H",
+            },
             levels.last().map_or(f64::NAN, |l| l.estimate),
             a.tolerance,
             levels.last().map_or(0, |l| l.harmonics),

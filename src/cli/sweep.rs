@@ -272,9 +272,13 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 .filter_map(|p| p.error_estimate_harmonics)
                 .fold(f64::NAN, f64::max);
             say!(
-                "  largest error estimate {e:.1e} (at {:.6} {unit}), of harmonics 0..{} {kept:.1e} (against 2H = {})",
+                "  largest error estimate {e:.1e} (at {:.6} {unit}){} (against 2H = {})",
                 speed(w),
-                branch.harmonics,
+                if kept.is_nan() {
+                    String::new()
+                } else {
+                    format!(", of harmonics 0..{} {kept:.1e}", branch.harmonics)
+                },
                 2 * branch.harmonics
             );
         }
@@ -388,8 +392,12 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             .max_by(|a, b| a.0.total_cmp(&b.0));
         if let Some((e, w)) = worst.filter(|(e, _)| *e > auto.tolerance) {
             eprintln!(
-                "warning: {}: error estimate up to {e:.1e} (at {} {unit}), above the tolerance {:.0e} of the H = {} chosen at the first speed: start the sweep there or raise harmonics.count",
+                "warning: {}: error estimate{} up to {e:.1e} (at {} {unit}), above the tolerance {:.0e} of the H = {} chosen at the first speed: start the sweep there or raise harmonics.count",
                 scene.file,
+                match auto.control {
+                    hbal::solve::Control::Solution => "",
+                    hbal::solve::Control::Harmonics => " of the harmonics 0..H",
+                },
                 speed(w),
                 auto.tolerance,
                 branch.harmonics

@@ -11,7 +11,8 @@ use std::path::Path;
 /// interpolated fold position (empty unless the point closes a fold) and whether a turning
 /// point of the discretised branch ends here that the multipliers do not confirm
 /// (`spurious_turn`), the located position of a bifurcation other than a fold (empty
-/// unless the point closes one) and the point's error estimate (empty if not computed). `parameter(p)` maps the point's swept parameter and the fold position to
+/// unless the point closes one) and the point's error estimates, of the periodic solution and
+/// of its harmonics 0..H (empty if not computed). `parameter(p)` maps the point's swept parameter and the fold position to
 /// the parameter's unit (e.g. Ω to rpm). The amplitude columns `amp_<dof>_k<k>_order_<o>` name
 /// the harmonic k and its order o = k/ν of the fundamental (ν the branch's period multiple);
 /// [`branch_csv_orders`] states the fundamental's order of a reference shaft.

@@ -218,31 +218,62 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
         std::fs::write(&p, text).unwrap();
         hbal(&["solve", p.to_str().unwrap(), "--no-stability"])
     };
-    // The harmonics 0..H controlled (scene field and --harmonics): the JSON says so and its
-    // kept-harmonics estimate is within the tolerance.
-    for (harmonics, extra) in [
-        (
-            "harmonics = { auto = true, count = 4, control = \"harmonics\" }",
-            None,
-        ),
-        ("harmonics = { count = 4 }", Some("auto:harmonics")),
-    ] {
-        let text = std::fs::read_to_string(&backlash)
-            .unwrap()
-            .replace("harmonics = { count = 7 }", harmonics);
-        let p = dir.join("kept.toml");
-        std::fs::write(&p, text).unwrap();
+    // What automatic harmonics control, on the two-shaft model at 6000 rpm, where it matters:
+    // its harmonics 0..H reach 1e-6 at H = 32, the periodic solution not below H = 512.
+    let two_shaft = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/two_shaft_6000rpm.toml"),
+    )
+    .unwrap()
+    .replace(
+        "[harmonics]\ncount = 32\n",
+        "[harmonics]\nauto = true\ncount = 32\nmax = 64\ncontrol = \"harmonics\"\n",
+    );
+    assert!(two_shaft.contains("control"));
+    let p = dir.join("two_shaft.toml");
+    std::fs::write(&p, two_shaft).unwrap();
+    let solve = |harmonics: Option<&str>| {
         let mut args = vec!["solve", p.to_str().unwrap(), "--no-stability", "--json"];
-        if let Some(h) = extra {
+        if let Some(h) = harmonics {
             args.extend(["--harmonics", h]);
         }
         let out = hbal(&args);
-        assert_eq!(out.status.code(), Some(0), "{harmonics} {extra:?}");
         let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(doc["auto_harmonics"]["control"], "harmonics");
+        (out, doc)
+    };
+    // The scene's control, also with a bare `--harmonics auto`.
+    for flag in [None, Some("auto"), Some("auto:harmonics")] {
+        let (out, doc) = solve(flag);
+        assert_eq!(out.status.code(), Some(0), "{flag:?}");
+        assert_eq!(doc["auto_harmonics"]["control"], "harmonics", "{flag:?}");
+        assert_eq!(doc["harmonics"], 32, "{flag:?}");
         let kept = doc["error_estimate"]["kept_harmonics"].as_f64().unwrap();
         assert!((1e-15..=1e-6).contains(&kept), "{kept}");
+        assert!(doc["error_estimate"]["relative"].as_f64().unwrap() > 1e-4);
     }
+    // `auto:solution` overrides it: capped at H = 64, exit 1, the message says which error.
+    let (out, doc) = solve(Some("auto:solution"));
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(doc["auto_harmonics"]["control"], "solution");
+    assert_eq!(doc["harmonics"], 64);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("of the periodic solution") && err.contains("at the cap H = 64"),
+        "{err}"
+    );
+    // A sweep checks the estimate it controls along the branch: no warning here.
+    let out = hbal(&[
+        "sweep",
+        p.to_str().unwrap(),
+        "--from",
+        "6000",
+        "--to",
+        "6030",
+        "--no-stability",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("on the harmonics 0..H: H = 32"), "{err}");
+    assert!(!err.contains("warning"), "{err}");
     // A cap below what the tolerance needs: the last level, exit 1 and a message.
     let out = scene("harmonics = { auto = true, count = 1, tolerance = 1e-12, max = 2 }");
     assert_eq!(out.status.code(), Some(1));

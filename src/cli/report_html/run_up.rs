@@ -17,10 +17,16 @@ pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
     };
     let points = doc["points"].as_array().map_or(&[][..], Vec::as_slice);
     let unstable = points.iter().filter(|p| p["stable"] == false).count();
-    let worst = points
-        .iter()
-        .filter_map(|p| p["error_estimate"].as_f64())
-        .fold(0.0f64, f64::max);
+    let largest = |key: &str| {
+        points
+            .iter()
+            .filter_map(|p| p[key].as_f64())
+            .fold(0.0f64, f64::max)
+    };
+    let (worst, kept) = (
+        largest("error_estimate"),
+        largest("error_estimate_harmonics"),
+    );
     r.status(
         doc["reached"].as_bool() == Some(true),
         &format!(
@@ -34,7 +40,14 @@ pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
     r.facts(&[
         ("folds", doc["folds"].to_string()),
         ("unstable points", unstable.to_string()),
-        ("largest error estimate", significant(worst, 2)),
+        (
+            "largest error estimate",
+            format!(
+                "{}, of the harmonics 0..H {}",
+                significant(worst, 2),
+                significant(kept, 2)
+            ),
+        ),
         ("time", format!("{} s", num(&doc["seconds"]))),
     ]);
     if let Some(losses) = doc["contact_loss"].as_array().filter(|l| !l.is_empty()) {

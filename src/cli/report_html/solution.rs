@@ -56,9 +56,18 @@ pub(super) fn solve_section(r: &mut HtmlReport, i: &Inputs) {
             "error estimate",
             match estimate["relative"].as_f64() {
                 Some(e) => format!(
-                    "{} (against H = {})",
+                    "{}, of harmonics 0..{} {} (against H = {}){}",
                     significant(e, 2),
-                    estimate["reference_harmonics"]
+                    doc["harmonics"],
+                    estimate["kept_harmonics"]
+                        .as_f64()
+                        .map_or("?".to_string(), |k| significant(k, 2)),
+                    estimate["reference_harmonics"],
+                    match doc["auto_harmonics"]["control"].as_str() {
+                        Some("harmonics") => "; automatic harmonics on the harmonics 0..H",
+                        Some(_) => "; automatic harmonics on the periodic solution",
+                        None => "",
+                    }
                 ),
                 None => estimate["error"]
                     .as_str()
