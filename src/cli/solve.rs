@@ -212,10 +212,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             say!(
                 "  harmonics: auto, tolerance {:.0e} on {}{}: {}",
                 a.tolerance,
-                match a.control {
-                    hbal::solve::Control::Solution => "the periodic solution",
-                    hbal::solve::Control::Harmonics => "the harmonics 0..H",
-                },
+                a.control.what(),
                 if *capped { " (NOT reached)" } else { "" },
                 steps.join(", ")
             );
@@ -322,12 +319,9 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let capped = matches!(&auto, Some((_, _, true)));
     if let Some((a, levels, true)) = &auto {
         eprintln!(
-            "error: {}: automatic harmonics: the estimated error{} {:.1e} is above the tolerance {:.0e} at the cap H = {} (harmonics.max)",
+            "error: {}: automatic harmonics: the estimated error of {} {:.1e} is above the tolerance {:.0e} at the cap H = {} (harmonics.max)",
             scene.file,
-            match a.control {
-                hbal::solve::Control::Solution => " of the periodic solution",
-                hbal::solve::Control::Harmonics => " of the harmonics 0..H",
-            },
+            a.control.what(),
             levels.last().map_or(f64::NAN, |l| l.estimate),
             a.tolerance,
             levels.last().map_or(0, |l| l.harmonics),

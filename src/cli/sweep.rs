@@ -119,10 +119,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         eprintln!(
             "note: harmonics: auto, tolerance {:.0e}{}: H = {} (error estimate {:.1e} at {from} {unit}{}), kept along the branch",
             auto.tolerance,
-            match auto.control {
-                hbal::solve::Control::Solution => "",
-                hbal::solve::Control::Harmonics => " on the harmonics 0..H",
-            },
+            auto.control.pick("", " on the harmonics 0..H"),
             basis.harmonics(),
             auto.control.of(&a.estimate),
             if a.capped { ", above the tolerance at the cap" } else { "" }
@@ -381,23 +378,21 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     }
     // Automatic harmonics chose H at the first speed: say so if the branch needs more.
     if let Some(auto) = scene.auto {
-        let controlled = |p: &hbal::continuation::BranchPoint| match auto.control {
-            hbal::solve::Control::Solution => p.error_estimate,
-            hbal::solve::Control::Harmonics => p.error_estimate_harmonics,
-        };
         let worst = branch
             .points
             .iter()
-            .filter_map(|p| controlled(p).map(|e| (e, p.omega)))
+            .filter_map(|p| {
+                let e = auto
+                    .control
+                    .pick(p.error_estimate, p.error_estimate_harmonics);
+                e.map(|e| (e, p.omega))
+            })
             .max_by(|a, b| a.0.total_cmp(&b.0));
         if let Some((e, w)) = worst.filter(|(e, _)| *e > auto.tolerance) {
             eprintln!(
                 "warning: {}: error estimate{} up to {e:.1e} (at {} {unit}), above the tolerance {:.0e} of the H = {} chosen at the first speed: start the sweep there or raise harmonics.count",
                 scene.file,
-                match auto.control {
-                    hbal::solve::Control::Solution => "",
-                    hbal::solve::Control::Harmonics => " of the harmonics 0..H",
-                },
+                auto.control.pick("", " of the harmonics 0..H"),
                 speed(w),
                 auto.tolerance,
                 branch.harmonics

@@ -199,13 +199,7 @@ impl Envelope {
             }
             work[i * C..(i + 1) * C].copy_from_slice(&row);
         }
-        // D z = y.
-        for (i, row) in work.chunks_exact_mut(C).enumerate() {
-            let inv = values[self.start[i] + (i - self.first[i])];
-            for r in row.iter_mut() {
-                *r *= inv;
-            }
-        }
+        self.scale_by_pivots(values, work, C);
         // Lᵀ x = z, from the last row: row i, final, updates the rows k < i of its envelope.
         for i in (0..n).rev() {
             let (fi, si) = (self.first[i], self.start[i]);
@@ -215,6 +209,16 @@ impl Envelope {
                 for c in 0..C {
                     dst[c] -= l * row[c];
                 }
+            }
+        }
+    }
+
+    /// `D z = y`: every row of `work` (row-major, `columns` wide) times its `D⁻¹`.
+    fn scale_by_pivots(&self, values: &[Complex64], work: &mut [Complex64], columns: usize) {
+        for (i, row) in work.chunks_exact_mut(columns).enumerate() {
+            let inv = values[self.start[i] + (i - self.first[i])];
+            for r in row.iter_mut() {
+                *r *= inv;
             }
         }
     }
@@ -237,13 +241,7 @@ impl Envelope {
                 }
             }
         }
-        // D z = y.
-        for (i, row) in work.chunks_exact_mut(columns).enumerate() {
-            let inv = values[self.start[i] + (i - self.first[i])];
-            for r in row.iter_mut() {
-                *r *= inv;
-            }
-        }
+        self.scale_by_pivots(values, work, columns);
         // Lᵀ x = z, from the last row: row i, final, updates the rows k < i of its envelope.
         for i in (0..n).rev() {
             let (fi, si) = (self.first[i], self.start[i]);

@@ -158,12 +158,22 @@ pub enum Control {
 }
 
 impl Control {
+    /// `solution` or `harmonics`, whichever this control names.
+    pub fn pick<T>(self, solution: T, harmonics: T) -> T {
+        match self {
+            Control::Solution => solution,
+            Control::Harmonics => harmonics,
+        }
+    }
+
     /// The controlled part of `estimate`.
     pub fn of(self, estimate: &ErrorEstimate) -> f64 {
-        match self {
-            Control::Solution => estimate.relative,
-            Control::Harmonics => estimate.kept_harmonics,
-        }
+        self.pick(estimate.relative, estimate.kept_harmonics)
+    }
+
+    /// What is controlled, in words: "the periodic solution" or "the harmonics 0..H".
+    pub fn what(self) -> &'static str {
+        self.pick("the periodic solution", "the harmonics 0..H")
     }
 }
 
