@@ -35,6 +35,10 @@ pub struct Condensation {
     solved: Vec<Vec<Complex64>>,
     /// The full load `F` the kept solutions were made with.
     solved_load: Vec<Complex64>,
+    /// The kept solutions belong to the current factors.
+    solved_valid: bool,
+    /// Each harmonic's work space of the multi-column solve, kept between speeds.
+    work: Vec<Vec<Complex64>>,
 }
 
 /// The most memory the solved columns `Z_k⁻¹ [W | F_k]` may take (beyond it, each recovery
@@ -98,6 +102,8 @@ impl Condensation {
                 z,
                 solved: Vec::new(),
                 solved_load: Vec::new(),
+                solved_valid: false,
+                work: Vec::new(),
             },
             map,
         ))
@@ -126,7 +132,7 @@ impl Condensation {
     /// Factors `Z_k` for another Ω (each harmonic's factor is verified by the next
     /// [`linear_part`](Self::linear_part), which must follow).
     pub fn refactor(&mut self, basis: &HarmonicBasis) -> Result<()> {
-        self.solved.clear();
+        self.solved_valid = false;
         self.z.refactor_unverified(basis)
     }
 
@@ -141,21 +147,30 @@ impl Condensation {
         let h = self.z.harmonics();
         let keep = self.z.is_symmetric()
             && (h + 1) * n * (m + 1) * std::mem::size_of::<Complex64>() <= MAX_KEPT_BYTES;
-        self.solved.clear();
+        // The last speed's buffers, filled again (fresh pages cost more than the solves).
+        self.solved_valid = false;
+        let (mut xs, mut works) = (
+            std::mem::take(&mut self.solved),
+            std::mem::take(&mut self.work),
+        );
+        xs.resize_with(h + 1, Vec::new);
+        works.resize_with(h + 1, Vec::new);
+        let buffers: Vec<_> = xs.into_iter().zip(works).collect();
         let this = &*self;
         let threads = super::parallel::threads(n * (h + 1));
-        let solved = super::parallel::map(h + 1, threads, |k| {
-            let x = this.solve_harmonic(k, f);
+        let solved = super::parallel::map_owned(buffers, threads, |k, (mut x, mut work)| {
+            this.solve_harmonic(k, f, &mut x, &mut work);
             let passed = this.z.check(k, &x[(m + 1) * n..]);
-            (x, passed)
+            (x, work, passed)
         });
         let mut stiffness = Vec::with_capacity(h + 1);
         let mut load = vec![Complex64::default(); (h + 1) * m];
-        for (k, (mut x, passed)) in solved.into_iter().enumerate() {
+        for (k, (mut x, mut work, passed)) in solved.into_iter().enumerate() {
             // A factor that failed its test: the pivoting LU, and that harmonic solved again.
             if !passed && !self.z.verify(k, &x[(m + 1) * n..])? {
-                x = self.solve_harmonic(k, f);
+                self.solve_harmonic(k, f, &mut x, &mut work);
             }
+            self.work.push(work);
             let g = DMatrix::from_fn(m, m, |r, c| self.gather(r, &x[c * n..(c + 1) * n]));
             let u_lin: Vec<Complex64> = (0..m)
                 .map(|r| self.gather(r, &x[m * n..(m + 1) * n]))
@@ -182,15 +197,25 @@ impl Condensation {
             }
         }
         if keep {
-            self.solved_load = f.to_vec();
+            self.solved_load.clear();
+            self.solved_load.extend_from_slice(f);
+            self.solved_valid = true;
         }
         Ok(CondensedLinear { stiffness, load })
     }
 
-    /// `Z_k⁻¹ [W | F_k | b]` (n × (m+2), column-major), `b` the factor's test vector.
-    fn solve_harmonic(&self, k: usize, f: &[Complex64]) -> Vec<Complex64> {
+    /// `x ← Z_k⁻¹ [W | F_k | b]` (n × (m+2), column-major), `b` the factor's test vector
+    /// (`work` the solve's work space).
+    fn solve_harmonic(
+        &self,
+        k: usize,
+        f: &[Complex64],
+        x: &mut Vec<Complex64>,
+        work: &mut Vec<Complex64>,
+    ) {
         let (n, m) = (self.z.n(), self.len());
-        let mut x = vec![Complex64::default(); n * (m + 2)];
+        x.clear();
+        x.resize(n * (m + 2), Complex64::default());
         for (c, w) in self.coordinates.iter().enumerate() {
             for &(i, wi) in w {
                 x[c * n + i] = Complex64::new(wi, 0.0);
@@ -200,14 +225,12 @@ impl Condensation {
         for (xi, bi) in x[(m + 1) * n..].iter_mut().zip(self.z.test_vector()) {
             *xi = bi;
         }
-        let mut work = Vec::new();
-        self.z.solve_in_place_with(k, &mut x, m + 2, &mut work);
-        x
+        self.z.solve_in_place_with(k, x, m + 2, work);
     }
 
     /// The kept `Z_k⁻¹ [W | F_k]` of every harmonic, if kept for the full load `f`.
     fn kept(&self, f: &[Complex64]) -> Option<&[Vec<Complex64>]> {
-        (self.solved.len() == self.z.harmonics() + 1 && self.solved_load == f)
+        (self.solved_valid && self.solved.len() == self.z.harmonics() + 1 && self.solved_load == f)
             .then_some(&self.solved[..])
     }
 

@@ -1,5 +1,5 @@
 //! The harmonics of one speed are independent: `Z_k` is factored and solved for every `k`
-//! on its own. [`map`] spreads such per-harmonic work over the machine's cores (scoped
+//! on its own. [`map_owned`] spreads such per-harmonic work over the machine's cores (scoped
 //! threads, harmonic `k` on thread `k mod T`), with the results in harmonic order and each
 //! result computed exactly as on one thread, so the answers do not depend on the thread count.
 //!
@@ -27,16 +27,31 @@ pub(crate) fn threads(work: usize) -> usize {
     cores.min(asked).max(1)
 }
 
-/// `[f(0), f(1), …, f(count - 1)]` on up to `threads` threads.
-pub(crate) fn map<T: Send>(count: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+/// `[f(0, items[0]), f(1, items[1]), …]` on up to `threads` threads: each call owns its item
+/// (a buffer of the last speed's, to be filled again instead of allocated).
+pub(crate) fn map_owned<B: Send, T: Send>(
+    items: Vec<B>,
+    threads: usize,
+    f: impl Fn(usize, B) -> T + Sync,
+) -> Vec<T> {
+    let count = items.len();
     let threads = threads.min(count);
     if threads <= 1 {
-        return (0..count).map(f).collect();
+        return items
+            .into_iter()
+            .enumerate()
+            .map(|(k, b)| f(k, b))
+            .collect();
+    }
+    let mut shares: Vec<Vec<(usize, B)>> = (0..threads).map(|_| Vec::new()).collect();
+    for (k, b) in items.into_iter().enumerate() {
+        shares[k % threads].push((k, b));
     }
     let f = &f;
     let mut parts: Vec<Vec<T>> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads)
-            .map(|t| s.spawn(move || (t..count).step_by(threads).map(f).collect::<Vec<T>>()))
+        let handles: Vec<_> = shares
+            .into_iter()
+            .map(|share| s.spawn(move || share.into_iter().map(|(k, b)| f(k, b)).collect()))
             .collect();
         handles
             .into_iter()
@@ -52,10 +67,15 @@ pub(crate) fn map<T: Send>(count: usize, threads: usize, f: impl Fn(usize) -> T 
 #[cfg(test)]
 mod tests {
     #[test]
-    fn results_come_back_in_index_order() {
-        let serial: Vec<usize> = super::map(37, 1, |k| k * k);
-        let spread: Vec<usize> = super::map(37, 3, |k| k * k);
+    fn owned_items_come_back_in_index_order() {
+        let items = |_: ()| (0..37).map(|k| vec![k; 3]).collect::<Vec<_>>();
+        let f = |k: usize, mut b: Vec<usize>| {
+            b.push(k * k);
+            b
+        };
+        let serial = super::map_owned(items(()), 1, f);
+        let spread = super::map_owned(items(()), 3, f);
         assert_eq!(serial, spread);
-        assert_eq!(spread[36], 1296);
+        assert_eq!(spread[36], vec![36, 36, 36, 1296]);
     }
 }

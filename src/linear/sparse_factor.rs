@@ -37,12 +37,20 @@ impl SparseDynamicStiffness {
     fn refactor_checked(&mut self, basis: &HarmonicBasis, verify: bool) -> Result<()> {
         let fundamental = basis.fundamental();
         self.fundamental = fundamental;
-        self.factors.clear();
         let count = basis.harmonics() + 1;
+        // The last factors' storage, filled again (no fresh pages per speed).
+        let mut storage: Vec<Vec<Complex64>> = std::mem::take(&mut self.factors)
+            .into_iter()
+            .map(|f| match f {
+                Factor::Envelope(v) => v,
+                Factor::Lu(_) => Vec::new(),
+            })
+            .collect();
+        storage.resize_with(count, Vec::new);
         let this = &*self;
         let threads = super::parallel::threads(self.pattern.n * count);
-        let made = super::parallel::map(count, threads, |k| {
-            this.envelope_factor(k, k as f64 * fundamental, verify || k == 0)
+        let made = super::parallel::map_owned(storage, threads, |k, v| {
+            this.envelope_factor(k, k as f64 * fundamental, verify || k == 0, v)
         });
         for (k, made) in made.into_iter().enumerate() {
             let f = match made? {
@@ -84,8 +92,7 @@ impl SparseDynamicStiffness {
             return true;
         }
         let w = k as f64 * self.fundamental;
-        let values = self.pattern.values(w, 0.0);
-        self.backward_error_of(x, w, 0.0, &values) < SINGULAR_RESIDUAL
+        self.backward_error_of(x, w, 0.0, self.pattern.values_norm(w, 0.0)) < SINGULAR_RESIDUAL
     }
 
     /// `Z_kᵀ = Z_k` for every k (symmetric `M`, `D0`, `K0`), so that
@@ -96,7 +103,7 @@ impl SparseDynamicStiffness {
 
     /// The factor of `Z_k` at `w = kΩ` (`K0 + σM` at k = 0).
     pub(super) fn factor(&mut self, k: usize, w: f64, verify: bool) -> Result<Factor> {
-        match self.envelope_factor(k, w, verify)? {
+        match self.envelope_factor(k, w, verify, Vec::new())? {
             Some(f) => Ok(f),
             None => {
                 let s = if k == 0 { self.shift } else { 0.0 };
@@ -108,34 +115,41 @@ impl SparseDynamicStiffness {
 
     /// The envelope `L D Lᵀ` of `Z_k` at `w`, `None` where there is no envelope, a zero pivot
     /// or (with `verify`) a backward error above the threshold; an error for non-finite values.
-    fn envelope_factor(&self, k: usize, w: f64, verify: bool) -> Result<Option<Factor>> {
+    ///
+    /// `v` is storage to fill (a factor of the last speed, or empty).
+    fn envelope_factor(
+        &self,
+        k: usize,
+        w: f64,
+        verify: bool,
+        mut v: Vec<Complex64>,
+    ) -> Result<Option<Factor>> {
         let s = if k == 0 { self.shift } else { 0.0 };
-        let values = self.pattern.values(w, s);
-        if values
-            .iter()
-            .any(|v| !(v.re.is_finite() && v.im.is_finite()))
-        {
+        let norm = self.pattern.values_norm(w, s);
+        if norm.is_nan() {
             return Err(crate::harmonic::non_finite_stiffness(k, w));
         }
         let Some((env, slots)) = &self.envelope else {
             return Ok(None);
         };
-        let mut v = vec![Complex64::default(); env.size()];
+        v.clear();
+        v.resize(env.size(), Complex64::default());
         for &(p, slot) in slots {
-            v[slot] = values[p];
+            v[slot] = self.pattern.value(p, w, s);
         }
         if !env.factor(&mut v) {
             return Ok(None);
         }
         let f = Factor::Envelope(v);
-        Ok((!verify || self.backward_error(&f, w, s, &values) < SINGULAR_RESIDUAL).then_some(f))
+        Ok((!verify || self.backward_error(&f, w, s, norm) < SINGULAR_RESIDUAL).then_some(f))
     }
 
     /// faer's pivoting LU of `values` (`Z_k` at `w`), rejected by its backward error.
     fn lu_checked(&mut self, k: usize, w: f64, values: Vec<Complex64>) -> Result<Factor> {
         let s = if k == 0 { self.shift } else { 0.0 };
-        let f = self.lu(values.clone()).ok_or_else(|| singular(k, w, 0.0))?;
-        let rel = self.backward_error(&f, w, s, &values);
+        let norm = self.pattern.values_norm(w, s);
+        let f = self.lu(values).ok_or_else(|| singular(k, w, 0.0))?;
+        let rel = self.backward_error(&f, w, s, norm);
         if rel.is_nan() || rel >= SINGULAR_RESIDUAL {
             return Err(singular(
                 k,
@@ -160,14 +174,16 @@ impl SparseDynamicStiffness {
     }
 
     /// The backward error of solving with `f` for `b = (1, 2, ..., n)`.
-    fn backward_error(&self, f: &Factor, w: f64, s: f64, values: &[Complex64]) -> f64 {
+    /// (`norm` = `‖Z‖_F`, [`values_norm`](super::sparse_pattern::SparsePattern::values_norm).)
+    fn backward_error(&self, f: &Factor, w: f64, s: f64, norm: f64) -> f64 {
         let mut x: Vec<Complex64> = self.test_vector().collect();
         self.solve_with(f, &mut x, 1);
-        self.backward_error_of(&x, w, s, values)
+        self.backward_error_of(&x, w, s, norm)
     }
 
-    /// The backward error of `x` as the solution for the test vector.
-    fn backward_error_of(&self, x: &[Complex64], w: f64, s: f64, values: &[Complex64]) -> f64 {
+    /// The backward error of `x` as the solution for the test vector (`values_norm` =
+    /// `‖Z‖_F`).
+    fn backward_error_of(&self, x: &[Complex64], w: f64, s: f64, values_norm: f64) -> f64 {
         let n = self.pattern.n;
         let b: Vec<Complex64> = self.test_vector().collect();
         let mut back = vec![Complex64::default(); n];
@@ -179,7 +195,7 @@ impl SparseDynamicStiffness {
             .map(|(a, c)| (a - c).norm_sqr())
             .sum::<f64>()
             .sqrt();
-        let rel = err / (norm(values) * norm(x) + norm(&b));
+        let rel = err / (values_norm * norm(x) + norm(&b));
         if rel.is_finite() {
             rel
         } else {

@@ -15,6 +15,8 @@ pub struct SparsePattern {
     pub(super) m: Vec<f64>,
     pub(super) d: Vec<f64>,
     pub(super) k: Vec<f64>,
+    /// `(Σ k², Σ k m, Σ m², Σ d²)` over the entries, for [`values_norm`](Self::values_norm).
+    sums: [f64; 4],
 }
 
 impl SparsePattern {
@@ -54,6 +56,8 @@ impl SparsePattern {
         for j in 0..n {
             col_ptr[j + 1] += col_ptr[j];
         }
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let sums = [dot(&kv, &kv), dot(&kv, &mv), dot(&mv, &mv), dot(&dv, &dv)];
         Self {
             n,
             col_ptr,
@@ -61,6 +65,7 @@ impl SparsePattern {
             m: mv,
             d: dv,
             k: kv,
+            sums,
         }
     }
 
@@ -99,9 +104,28 @@ impl SparsePattern {
 
     /// The values of `Z(w) + s M = -(w² - s) M + i w D0 + K0` on the pattern.
     pub(super) fn values(&self, w: f64, s: f64) -> Vec<Complex64> {
-        (0..self.nnz())
-            .map(|p| Complex64::new(self.k[p] - (w * w - s) * self.m[p], w * self.d[p]))
-            .collect()
+        (0..self.nnz()).map(|p| self.value(p, w, s)).collect()
+    }
+
+    /// Entry `p` of [`values`](Self::values).
+    #[inline]
+    pub(super) fn value(&self, p: usize, w: f64, s: f64) -> Complex64 {
+        Complex64::new(self.k[p] - (w * w - s) * self.m[p], w * self.d[p])
+    }
+
+    /// `‖Z(w) + s M‖_F` without forming the values: with `a = w² - s`,
+    /// `Σ |k - a m + i w d|² = Σk² - 2a Σkm + a² Σm² + w² Σd²` (the sums kept; rounding of
+    /// about 1e-16 of `‖K‖² + a²‖M‖²`, enough for the backward error it scales). NaN if `w`
+    /// is too large for a finite value.
+    pub(super) fn values_norm(&self, w: f64, s: f64) -> f64 {
+        let [kk, km, mm, dd] = self.sums;
+        let a = w * w - s;
+        let sum = kk - 2.0 * a * km + a * a * mm + w * w * dd;
+        if sum.is_finite() {
+            sum.max(0.0).sqrt()
+        } else {
+            f64::NAN
+        }
     }
 
     /// `out ← (Z(w) + s M) x`.
