@@ -1,6 +1,6 @@
 //! `hbal compare`: run every solver (or the one of `--method`) and the time-domain reference on
 //! one scene, and print a table (or one JSON object) of results, timings and errors against the
-//! time domain.
+//! time domain; with automatic harmonics every method runs at the H they choose.
 
 use super::{load, Failure, SolverArgs};
 use anyhow::Context;
@@ -26,9 +26,24 @@ pub(crate) fn compare(
         Some(_) => vec![scene.method.name()],
         None => hbal::scene::METHODS.to_vec(),
     };
-    let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
+    // Automatic harmonics: every solver and the comparison at the H they choose.
+    let mut basis = scene.basis;
+    if let Some(auto) = scene.auto {
+        let a = hbal::solve::solve_auto(&scene.model, basis, &scene.method, auto)
+            .map_err(|e| super::failure(e, &scene.file))?;
+        basis = *a.solution.basis();
+        eprintln!(
+            "note: harmonics: auto, tolerance {:.0e}{}: every method at H = {} (error estimate {:.1e}{})",
+            auto.tolerance,
+            auto.control.pick("", " on the harmonics 0..H"),
+            basis.harmonics(),
+            auto.control.of(&a.estimate),
+            if a.capped { ", above the tolerance at the cap" } else { "" }
+        );
+    }
+    let hb = HarmonicBalance::with_formulation(&scene.model, basis, args.formulation)
         .with_context(|| scene.file.clone())?;
-    let h = scene.basis.harmonics();
+    let h = basis.harmonics();
     let n = scene.model.n_dofs();
     let mut solutions = Vec::new();
     for name in names {
@@ -59,7 +74,7 @@ pub(crate) fn compare(
         initial: start_state,
         ..TimeSimulation::default()
     }
-    .run(&scene.model, scene.basis.omega())
+    .run(&scene.model, basis.omega())
     .with_context(|| format!("{}: time-domain reference", scene.file))?;
     let mut rows = Vec::new();
     let mut histories = Vec::new();
@@ -96,7 +111,7 @@ pub(crate) fn compare(
     if as_json {
         say!(
             "{}",
-            json!({"scene": scene.file, "time_domain": td_json, "methods": rows})
+            json!({"scene": scene.file, "harmonics": h, "samples": basis.samples(), "time_domain": td_json, "methods": rows})
         );
     } else {
         say!(

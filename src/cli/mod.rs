@@ -174,22 +174,39 @@ pub(crate) fn load(path: &Path, args: &SolverArgs) -> Result<Scene, Failure> {
     }
     scene.method = args.with_tolerance(scene.method, &scene.file)?;
     scene.basis = basis_with(&scene.basis, args, &scene.file)?;
-    if let Some(auto) = scene.auto.as_mut() {
-        auto.formulation = args.formulation;
+    auto_with(&mut scene.auto, args);
+    Ok(scene)
+}
+
+/// The scene's automatic harmonics with `--harmonics` (`auto[:control]` turns them on, a count
+/// off) and `--formulation` applied.
+pub(crate) fn auto_with(auto: &mut Option<hbal::solve::AutoHarmonics>, args: &SolverArgs) {
+    if let Some(a) = auto.as_mut() {
+        a.formulation = args.formulation;
     }
     match args.harmonics {
         Some(HarmonicsArg::Auto(control)) => {
-            let auto = scene.auto.unwrap_or_default();
-            scene.auto = Some(hbal::solve::AutoHarmonics {
+            let a = auto.unwrap_or_default();
+            *auto = Some(hbal::solve::AutoHarmonics {
                 formulation: args.formulation,
-                control: control.unwrap_or(auto.control),
-                ..auto
+                control: control.unwrap_or(a.control),
+                ..a
             })
         }
-        Some(HarmonicsArg::Count(_)) => scene.auto = None,
+        Some(HarmonicsArg::Count(_)) => *auto = None,
         None => {}
     }
-    Ok(scene)
+}
+
+/// The basis of `H` and `N` of `chosen` (automatic harmonics at another speed or parameter)
+/// at the speed and with the tail correction of `basis`.
+pub(crate) fn basis_like(
+    basis: &HarmonicBasis,
+    chosen: &HarmonicBasis,
+) -> hbal::Result<HarmonicBasis> {
+    HarmonicBasis::new(basis.omega(), chosen.harmonics())?
+        .with_tail_correction(basis.tail_correction())
+        .with_samples(chosen.samples())
 }
 
 /// `basis` with `--harmonics` and `--samples` applied.

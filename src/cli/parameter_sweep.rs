@@ -1,7 +1,7 @@
 //! `hbal sweep --parameter <field>`: a warm-started sweep of one numeric scene field over
 //! `--points` values (does not follow folds), with stability (unless `--no-stability`), on the
-//! scene's basis or the one of `--harmonics`/`--samples`, and optionally branch.csv and one
-//! parameter-response SVG per DOF.
+//! scene's basis or the one of `--harmonics`/`--samples` (automatic harmonics: H and N chosen at
+//! the first value and kept), and optionally branch.csv and one parameter-response SVG per DOF.
 
 use super::{basis_with, Failure, SolverArgs};
 use anyhow::Context;
@@ -58,8 +58,27 @@ pub(crate) fn parameter_sweep(
     let mut probe = doc.clone();
     hbal::scene::set_parameter(&mut probe, name, from)
         .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
-    let probe = Scene::from_value(probe, &file)?;
-    basis_with(&probe.basis, opts.solver, &file)?;
+    let mut probe = Scene::from_value(probe, &file)?;
+    let first = basis_with(&probe.basis, opts.solver, &file)?;
+    // Automatic harmonics: H and N chosen at the first value, kept for the others.
+    super::auto_with(&mut probe.auto, opts.solver);
+    let chosen = match probe.auto {
+        Some(auto) => {
+            let a = hbal::solve::solve_auto(&probe.model, first, &probe.method, auto)
+                .map_err(|e| super::failure(e, &file))?;
+            let b = *a.solution.basis();
+            eprintln!(
+                "note: harmonics: auto, tolerance {:.0e}{}: H = {} (error estimate {:.1e} at {name} = {from}{}), kept for every value and not checked at the others",
+                auto.tolerance,
+                auto.control.pick("", " on the harmonics 0..H"),
+                b.harmonics(),
+                auto.control.of(&a.estimate),
+                if a.capped { ", above the tolerance at the cap" } else { "" }
+            );
+            Some(b)
+        }
+        None => None,
+    };
     let reported = super::dof_selection::reported_dofs(&probe.model, opts.dofs)?;
     if let Some(dir) = out {
         for dof in probe.model.dof_names() {
@@ -85,10 +104,13 @@ pub(crate) fn parameter_sweep(
             let scene = Scene::from_value(d, &file).map_err(|e| hbal::Error::Solver {
                 reason: e.to_string(),
             })?;
-            let basis =
+            let mut basis =
                 basis_with(&scene.basis, opts.solver, &file).map_err(|e| hbal::Error::Solver {
                     reason: format!("{:#}", e.error),
                 })?;
+            if let Some(chosen) = &chosen {
+                basis = super::basis_like(&basis, chosen)?;
+            }
             Ok((scene.model, basis))
         },
         opts.stability
@@ -123,7 +145,7 @@ pub(crate) fn parameter_sweep(
             .collect();
         say!(
             "{}",
-            json!({"scene": file, "parameter": name, "stop": branch.stop.to_string(), "reached": branch.stop == BranchStop::Reached, "seconds": seconds, "dofs": branch.dofs, "points": pts})
+            json!({"scene": file, "parameter": name, "harmonics": branch.harmonics, "stop": branch.stop.to_string(), "reached": branch.stop == BranchStop::Reached, "seconds": seconds, "dofs": branch.dofs, "points": pts})
         );
     } else {
         say!(

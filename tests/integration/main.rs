@@ -14,6 +14,7 @@ mod bad_input;
 mod band_limited;
 mod branch_switching;
 mod cli;
+mod cli_auto_harmonics;
 mod cli_branches;
 mod cli_broken_scenes;
 mod cli_dofs;
