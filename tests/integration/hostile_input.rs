@@ -4,12 +4,10 @@
 
 use crate::common::hostile;
 
-use hbal::scene::Scene;
-use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
 use hostile::{judge, run_limited, write, Run};
 use std::path::{Path, PathBuf};
 
-fn example(name: &str) -> String {
+pub(crate) fn example(name: &str) -> String {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("examples/scenes")
         .join(name);
@@ -17,7 +15,7 @@ fn example(name: &str) -> String {
 }
 
 /// A directory of this test's own (tests run in parallel threads named after them).
-fn temp_dir() -> PathBuf {
+pub(crate) fn temp_dir() -> PathBuf {
     let test = std::thread::current()
         .name()
         .unwrap_or("main")
@@ -26,7 +24,7 @@ fn temp_dir() -> PathBuf {
 }
 
 /// `example` with `from` replaced by `to` (which must change it).
-fn edited(example_name: &str, from: &str, to: &str) -> String {
+pub(crate) fn edited(example_name: &str, from: &str, to: &str) -> String {
     let text = example(example_name);
     assert!(text.contains(from), "{example_name} lacks `{from}`");
     text.replace(from, to)
@@ -34,7 +32,7 @@ fn edited(example_name: &str, from: &str, to: &str) -> String {
 
 /// Runs `hbal args` (with `{}` replaced by the scene written as `name`) and checks the exit
 /// code and that stderr names the file and says `message`.
-fn expect(name: &str, scene: &str, args: &[&str], code: i32, message: &str) -> Run {
+pub(crate) fn expect(name: &str, scene: &str, args: &[&str], code: i32, message: &str) -> Run {
     let file = write(&temp_dir(), name, scene);
     let args: Vec<&str> = args
         .iter()
@@ -306,126 +304,5 @@ fn meaningless_fields_are_refused_with_their_path() {
         "--parameter harmonics.count takes whole numbers, and value 2 (6.333333333333333) is not \
          one: choose --from, --to and --points so that every value is whole",
     );
-    let _ = std::fs::remove_dir_all(temp_dir());
-}
-
-/// A force that overflows is a termination that names the element and the angle, said once;
-/// the JSON holds the last finite iterate and no `null`, and the exit code is 1.
-#[test]
-fn non_finite_forces_stop_with_where_not_nan() {
-    let scene = edited(
-        "polynomial_spring.toml",
-        "coefficients = [1.0, 0.5, 0.3]",
-        "coefficients = [1.0, 0.5, 0.3, 1e90]",
-    )
-    .replace("order = 1, cos = 0.3", "order = 1, cos = 1e10");
-    let run = expect(
-        "overflow.toml",
-        &scene,
-        &["solve", "--json", "{}", "--method", "anderson"],
-        1,
-        "",
-    );
-    let doc: serde_json::Value = serde_json::from_str(&run.stdout).expect("one JSON object");
-    assert_eq!(doc["converged"], false);
-    let termination = doc["termination"].as_str().expect("termination");
-    assert!(
-        termination.starts_with("non-finite value in force of element `spring` at θ = "),
-        "{termination}"
-    );
-    assert!(
-        !termination.contains("non-finite value in non-finite"),
-        "{termination}"
-    );
-    let _ = std::fs::remove_dir_all(temp_dir());
-}
-
-/// A start without a finite residual is an error that names the harmonic and DOF (there is no
-/// iterate to report), and a dynamic stiffness that overflows is not called a resonance.
-#[test]
-fn library_non_finite_errors_name_the_place() {
-    let text = example("duffing.toml").replace("cos = 0.1", "cos = 1e100");
-    let scene = Scene::from_str(&text, "duffing.toml").expect("in range");
-    let hb = HarmonicBalance::new(&scene.model, scene.basis).expect("discretised");
-    let err = Newton::new().solve(&hb, &mut hb.workspace()).unwrap_err();
-    let message = err.to_string();
-    assert!(
-        message.starts_with("non-finite value in the norm of the residual (its largest entry, ")
-            && message.ends_with("at harmonic 1 (cos) of `x`, overflows when squared)"),
-        "{message}"
-    );
-    let model = Model::builder(&["x"])
-        .mass_diagonal(&[1e308])
-        .stiffness(hbal::nalgebra::DMatrix::from_element(1, 1, 1.0))
-        .load("x", 1, 1.0, 0.0)
-        .build()
-        .expect("the library takes any finite mass");
-    let err = HarmonicBalance::new(&model, HarmonicBasis::new(2.0, 2).unwrap()).unwrap_err();
-    assert_eq!(
-        err.to_string(),
-        "non-finite value in the dynamic stiffness at harmonic 1 (2e0 rad/s): the mass, damping \
-         or stiffness times the frequency (squared) is out of range"
-    );
-    // A speed whose period is infinite is refused where the basis is made.
-    let err = HarmonicBasis::new(1e-320, 4).unwrap_err().to_string();
-    assert!(
-        err.contains("parameter `omega` must be finite and in [1e-100, 1e100] rad/s"),
-        "{err}"
-    );
-}
-
-/// A parameter sweep that meets an undamped resonance keeps its points and exits 1; an
-/// unusable `--out` is refused before the sweep (exit 2). (A DOF name that cannot be part of a
-/// file name is refused: tests/integration/report.rs.)
-#[test]
-fn parameter_sweep_failures_are_honest() {
-    let undamped = "dofs = [\"x1\"]\nmass = [[1.0]]\nstiffness = [[1.0]]\n\
-                    fundamental = { rad_s = 0.6 }\nharmonics = { count = 3 }\n\
-                    loads = [{ dof = \"x1\", order = 1, cos = 0.1 }]\n[[elements]]\n\
-                    name = \"s\"\ntype = \"cubic_spring\"\nconnects = { \"x1\" = 1.0 }\n\
-                    k = 0.0\nalpha = 0.1\n";
-    let dir = temp_dir();
-    let out = dir.join("out");
-    let out = out.to_str().expect("utf-8");
-    let sweep = [
-        "sweep",
-        "{}",
-        "--parameter",
-        "fundamental.rad_s",
-        "--from",
-        "0.6",
-        "--to",
-        "1.5",
-        "--points",
-        "10",
-        "--no-stability",
-        "--out",
-        out,
-    ];
-    let run = expect(
-        "undamped.toml",
-        undamped,
-        &sweep,
-        1,
-        "failed at parameter 1: dynamic stiffness is singular at harmonic 1",
-    );
-    assert!(
-        run.stdout.contains("4 values of fundamental.rad_s"),
-        "{}",
-        run.stdout
-    );
-    assert!(dir.join("out/parameter_response_x1.svg").is_file());
-    let blocked = dir.join("undamped.toml");
-    let blocked = format!("{}/sub", blocked.display());
-    let mut args = sweep;
-    args[12] = &blocked;
-    let run = expect(
-        "undamped.toml",
-        undamped,
-        &args,
-        2,
-        "cannot create the directory",
-    );
-    assert!(run.stdout.is_empty(), "{}", run.stdout);
     let _ = std::fs::remove_dir_all(temp_dir());
 }
