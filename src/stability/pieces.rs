@@ -113,11 +113,17 @@ impl Pieces {
         (theta, u, du): (f64, f64, f64),
         omega_s: f64,
     ) -> Option<f64> {
-        let (before, _, _) = self.law(sys, e, theta, u, du);
+        let (before, k0, d0) = self.law(sys, e, theta, u, du);
         self.cross(e, up);
-        let (after, _, _) = self.law(sys, e, theta, u, du);
+        let (after, k1, d1) = self.law(sys, e, theta, u, du);
         let jump = after - before;
-        if jump.abs() <= 1e-9 * before.abs().max(after.abs()) || du == 0.0 {
+        // Against the force's size on either side, not its value at the kink: a continuous
+        // law is about zero there (a backlash edge), and the rounding of the located crossing
+        // would pass for a jump (a rank-one update of Φ̃ per crossing for nothing).
+        let size = [before, after, k0 * u, k1 * u, d0 * du, d1 * du]
+            .iter()
+            .fold(0.0_f64, |m, f| m.max(f.abs()));
+        if jump.abs() <= 1e-9 * size || du == 0.0 {
             return None;
         }
         Some(-jump / (du * omega_s))
