@@ -283,4 +283,41 @@ mod tests {
         assert_eq!(at(top + 1e-9), None);
         assert_eq!(at(probed - 1e-9).map(|c| c.1), Some(true));
     }
+
+    /// A backlash edge crossed at a located `u` a rounding away from the kink: no saltation
+    /// for the continuous law (its force there is 1e-7 of `k u` on the contact side, and was
+    /// taken for a jump), the contact damping's true jump `c u̇` gives one.
+    #[test]
+    fn a_saltation_only_where_the_force_jumps() {
+        use crate::force::{Backlash, MeshProfile};
+        let build = |c: f64| {
+            let law = Backlash::new(1.0, MeshProfile::Constant { stiffness: 1e8 })
+                .with_contact_damping(c);
+            crate::Model::builder(&["x"])
+                .mass_diagonal(&[1.0])
+                .element("contact", &[("x", 1.0)], law)
+                .load("x", 1, 1.0, 0.0)
+                .build()
+                .unwrap()
+        };
+        let crossing = |c: f64| {
+            let model = build(c);
+            let sys = Coordinates::full(&model);
+            let mut pieces = Pieces::new(&sys);
+            // Inside the dead zone (kinks -1, 1), then up across +1 at u = 1 + 1e-15 (the
+            // law's force there 1e-7, against k u = 1e8 on the contact side).
+            pieces.side[0] = 1;
+            let u = 1.0 + 1e-15;
+            (
+                pieces.cross_jump(&sys, 0, true, (0.0, u, 2.0), 1.0),
+                pieces.interval(0),
+            )
+        };
+        let (factor, interval) = crossing(0.0);
+        assert_eq!(factor, None);
+        assert_eq!(interval, (1.0, f64::INFINITY));
+        // c u̇ = 0.5 · 2 = 1 N jumps in: S adds -Δf/(u̇ ω_s) = -0.5.
+        let (factor, _) = crossing(0.5);
+        assert!((factor.expect("a jump") + 0.5).abs() < 1e-6, "{factor:?}");
+    }
 }
