@@ -60,6 +60,17 @@ pub(crate) fn parameter_sweep(
         .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
     let mut probe = Scene::from_value(probe, &file)?;
     let first = basis_with(&probe.basis, opts.solver, &file)?;
+    let reported = super::dof_selection::reported_dofs(&probe.model, opts.dofs)?;
+    if let Some(dir) = out {
+        for dof in probe.model.dof_names() {
+            super::file_name_part(dof, "DOF")?;
+        }
+        super::prepare_out(dir)?;
+    }
+    let values: Vec<f64> = (0..points)
+        .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
+        .collect();
+    whole_values(&doc, name, &values, &file)?;
     // Automatic harmonics: H and N chosen at the first value, kept for the others.
     super::auto_with(&mut probe.auto, opts.solver);
     let chosen = match probe.auto {
@@ -79,17 +90,6 @@ pub(crate) fn parameter_sweep(
         }
         None => None,
     };
-    let reported = super::dof_selection::reported_dofs(&probe.model, opts.dofs)?;
-    if let Some(dir) = out {
-        for dof in probe.model.dof_names() {
-            super::file_name_part(dof, "DOF")?;
-        }
-        super::prepare_out(dir)?;
-    }
-    let values: Vec<f64> = (0..points)
-        .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
-        .collect();
-    whole_values(&doc, name, &values, &file)?;
     let bar = indicatif::ProgressBar::new(points as u64);
     if as_json {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());

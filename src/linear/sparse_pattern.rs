@@ -115,17 +115,28 @@ impl SparsePattern {
 
     /// `‖Z(w) + s M‖_F` without forming the values: with `a = w² - s`,
     /// `Σ |k - a m + i w d|² = Σk² - 2a Σkm + a² Σm² + w² Σd²` (the sums kept; rounding of
-    /// about 1e-16 of `‖K‖² + a²‖M‖²`, enough for the backward error it scales). NaN if `w`
-    /// is too large for a finite value.
+    /// about 1e-16 of `‖K‖² + a²‖M‖²`, enough for the backward error it scales). Where the
+    /// sums overflow (entries beyond 1e154), from the values, scaled; NaN if a value is not
+    /// finite.
     pub(super) fn values_norm(&self, w: f64, s: f64) -> f64 {
         let [kk, km, mm, dd] = self.sums;
         let a = w * w - s;
         let sum = kk - 2.0 * a * km + a * a * mm + w * w * dd;
         if sum.is_finite() {
-            sum.max(0.0).sqrt()
-        } else {
-            f64::NAN
+            return sum.max(0.0).sqrt();
         }
+        let mut top = 0.0_f64;
+        for p in 0..self.nnz() {
+            let v = self.value(p, w, s);
+            if !(v.re.is_finite() && v.im.is_finite()) {
+                return f64::NAN;
+            }
+            top = top.max(v.re.abs()).max(v.im.abs());
+        }
+        let scaled: f64 = (0..self.nnz())
+            .map(|p| (self.value(p, w, s) / top).norm_sqr())
+            .sum();
+        top * scaled.sqrt()
     }
 
     /// `out ← (Z(w) + s M) x`.
@@ -181,4 +192,49 @@ pub fn is_positive_definite(a: &SparseMatrix) -> bool {
     };
     let mat = SparseColMat::new(structure, values.to_vec());
     Llt::try_new_with_symbolic(symbolic, mat.as_ref(), Side::Lower).is_ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SparsePattern;
+    use crate::model::SparseMatrix;
+
+    /// The kept sums give the values' norm; beyond 1e154 the values themselves (finite, no
+    /// spurious overflow); a value that is not finite gives NaN.
+    #[test]
+    fn the_norm_from_the_sums_and_beyond_them() {
+        let pattern = |scale: f64| {
+            let m = SparseMatrix::from_triplets(2, &[(0, 0, 2.0), (1, 1, 1.0)]);
+            let d = SparseMatrix::from_triplets(2, &[(0, 0, 0.3)]);
+            let k = SparseMatrix::from_triplets(
+                2,
+                &[
+                    (0, 0, 5.0 * scale),
+                    (0, 1, -scale),
+                    (1, 0, -scale),
+                    (1, 1, 4.0 * scale),
+                ],
+            );
+            SparsePattern::new(&m, &d, &k)
+        };
+        let direct = |p: &SparsePattern, w: f64, s: f64| {
+            p.values(w, s)
+                .iter()
+                .map(|v| v.norm_sqr())
+                .sum::<f64>()
+                .sqrt()
+        };
+        let p = pattern(1.0);
+        for (w, s) in [(0.0, 0.0), (1.3, 0.0), (0.7, 0.25), (40.0, 0.0)] {
+            let (a, b) = (p.values_norm(w, s), direct(&p, w, s));
+            assert!((a - b).abs() <= 1e-13 * b, "{w} {s}: {a} {b}");
+        }
+        let huge = pattern(1e160);
+        let n = huge.values_norm(1.0, 0.0);
+        assert!(
+            n.is_finite() && (n / 1e160 - 43.0_f64.sqrt()).abs() < 1e-12,
+            "{n}"
+        );
+        assert!(p.values_norm(f64::INFINITY, 0.0).is_nan());
+    }
 }

@@ -104,26 +104,43 @@ impl Pieces {
     /// `c = -Δf / (u̇ ω_s)` of the saltation matrix of the force jump `Δf` there: with
     /// `g = w·q - kink` and `F = (q̇, M⁻¹(…))`, `S = I + (F⁺ - F⁻) ∇gᵀ / (∇g·F⁻)` adds
     /// `-M⁻¹ w Δf (wᵀ δq) / u̇` to `δq̇`, scaled `δṽ += c M⁻¹ w (wᵀ δq̃)` (`ω_s = s_v/s_q`).
-    /// `None` where the force is continuous.
+    /// `None` where the force is continuous. Both sides are evaluated on the kink itself; the
+    /// located `u` is not used.
     pub(crate) fn cross_jump(
         &mut self,
         sys: &Coordinates,
         e: usize,
         up: bool,
-        (theta, u, du): (f64, f64, f64),
+        (theta, _located, du): (f64, f64, f64),
         omega_s: f64,
     ) -> Option<f64> {
-        let (before, k0, d0) = self.law(sys, e, theta, u, du);
+        // Both sides' forces on the kink itself (`g = 0`), not at the located `u`: a law that
+        // is continuous there (a backlash edge) then differs by the rounding of its linear
+        // continuation alone, where at the located `u`, a rounding away from the kink, the
+        // contact side's `k (u - b)` passed for a jump (a rank-one update of Φ̃ per crossing
+        // for nothing). The jump is split into its part at rest, judged against that
+        // rounding, and its part in `u̇` (contact damping), judged by the damping
+        // coefficients alone: it counts however small `u̇` is (its factor `-Δd/ω_s` is not).
+        let (lo, hi) = self.interval(e);
+        let edge = if up { hi } else { lo };
+        let (f0, k0, d0) = self.law(sys, e, theta, edge, du);
         self.cross(e, up);
-        let (after, k1, d1) = self.law(sys, e, theta, u, du);
-        let jump = after - before;
-        // Against the force's size on either side, not its value at the kink: a continuous
-        // law is about zero there (a backlash edge), and the rounding of the located crossing
-        // would pass for a jump (a rank-one update of Φ̃ per crossing for nothing).
-        let size = [before, after, k0 * u, k1 * u, d0 * du, d1 * du]
-            .iter()
-            .fold(0.0_f64, |m, f| m.max(f.abs()));
-        if jump.abs() <= 1e-9 * size || du == 0.0 {
+        let (f1, k1, d1) = self.law(sys, e, theta, edge, du);
+        let (rest0, rest1) = (f0 - d0 * du, f1 - d1 * du);
+        let rounding = 16.0 * f64::EPSILON * (k0.abs() + k1.abs()) * edge.abs();
+        let at_rest = rest1 - rest0;
+        let at_rest = if at_rest.abs() <= 1e-9 * rest0.abs().max(rest1.abs()) + rounding {
+            0.0
+        } else {
+            at_rest
+        };
+        let damping = if (d1 - d0).abs() <= 1e-9 * d0.abs().max(d1.abs()) {
+            0.0
+        } else {
+            (d1 - d0) * du
+        };
+        let jump = at_rest + damping;
+        if jump == 0.0 || du == 0.0 {
             return None;
         }
         Some(-jump / (du * omega_s))
@@ -285,8 +302,8 @@ mod tests {
     }
 
     /// A backlash edge crossed at a located `u` a rounding away from the kink: no saltation
-    /// for the continuous law (its force there is 1e-7 of `k u` on the contact side, and was
-    /// taken for a jump), the contact damping's true jump `c u̇` gives one.
+    /// for the continuous law (its force there, 1.1e-7 N on the contact side, was taken for a
+    /// jump), the contact damping's true jump `c u̇` gives one, also at a grazing crossing.
     #[test]
     fn a_saltation_only_where_the_force_jumps() {
         use crate::force::{Backlash, MeshProfile};
@@ -300,7 +317,7 @@ mod tests {
                 .build()
                 .unwrap()
         };
-        let crossing = |c: f64| {
+        let crossing = |c: f64, du: f64| {
             let model = build(c);
             let sys = Coordinates::full(&model);
             let mut pieces = Pieces::new(&sys);
@@ -309,15 +326,18 @@ mod tests {
             pieces.side[0] = 1;
             let u = 1.0 + 1e-15;
             (
-                pieces.cross_jump(&sys, 0, true, (0.0, u, 2.0), 1.0),
+                pieces.cross_jump(&sys, 0, true, (0.0, u, du), 1.0),
                 pieces.interval(0),
             )
         };
-        let (factor, interval) = crossing(0.0);
+        let (factor, interval) = crossing(0.0, 2.0);
         assert_eq!(factor, None);
         assert_eq!(interval, (1.0, f64::INFINITY));
         // c u̇ = 0.5 · 2 = 1 N jumps in: S adds -Δf/(u̇ ω_s) = -0.5.
-        let (factor, _) = crossing(0.5);
-        assert!((factor.expect("a jump") + 0.5).abs() < 1e-6, "{factor:?}");
+        let (factor, _) = crossing(0.5, 2.0);
+        assert!((factor.expect("a jump") + 0.5).abs() < 1e-12, "{factor:?}");
+        // Grazing, u̇ = 1e-12: the jump c u̇ is tiny, its factor -c/ω_s is not.
+        let (factor, _) = crossing(0.5, 1e-12);
+        assert!((factor.expect("a jump") + 0.5).abs() < 1e-12, "{factor:?}");
     }
 }

@@ -5,25 +5,43 @@
 use crate::common::hbal;
 use std::path::{Path, PathBuf};
 
-/// The paper's two-shaft model at 6000 rpm with `count = 8` (written to a scratch directory):
-/// automatic harmonics on the harmonics 0..H go 8 -> 16 -> 32 to reach 1e-6.
-fn two_shaft_at_h8(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hbal-auto-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/two_shaft_6000rpm.toml"),
-    )
-    .unwrap()
-    .replace("[harmonics]\ncount = 32\n", "[harmonics]\ncount = 8\n");
-    assert!(text.contains("count = 8"));
-    let p = dir.join("two_shaft.toml");
-    std::fs::write(&p, text).unwrap();
-    p
+/// The paper's two-shaft model at 6000 rpm with `count = 8` and `extra` in its harmonics table,
+/// written to a scratch directory (removed when dropped): automatic harmonics on the harmonics
+/// 0..H go 8 -> 16 -> 32 to reach 1e-6.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn two_shaft_at_h8(tag: &str, extra: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("hbal-auto-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let text = std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/two_shaft_6000rpm.toml"),
+        )
+        .unwrap()
+        .replace(
+            "[harmonics]\ncount = 32\n",
+            &format!("[harmonics]\ncount = 8\n{extra}"),
+        );
+        assert!(text.contains("count = 8"));
+        std::fs::write(dir.join("two_shaft.toml"), text).unwrap();
+        Self(dir)
+    }
+
+    fn scene(&self) -> PathBuf {
+        self.0.join("two_shaft.toml")
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 #[test]
 fn compare_runs_every_method_at_the_automatic_h() {
-    let p = two_shaft_at_h8("compare");
+    let scratch = Scratch::two_shaft_at_h8("compare", "");
+    let p = scratch.scene();
     let run = |extra: &[&str]| {
         let mut args = vec![
             "compare",
@@ -59,8 +77,10 @@ fn compare_runs_every_method_at_the_automatic_h() {
 
 #[test]
 fn a_parameter_sweep_keeps_the_h_chosen_at_its_first_value() {
-    let p = two_shaft_at_h8("parameter");
-    let run = |extra: &[&str]| {
+    let plain = Scratch::two_shaft_at_h8("parameter", "");
+    let automatic =
+        Scratch::two_shaft_at_h8("parameter-auto", "auto = true\ncontrol = \"harmonics\"\n");
+    let run = |p: &Path, extra: &[&str]| {
         let mut args = vec![
             "sweep",
             p.to_str().unwrap(),
@@ -87,12 +107,15 @@ fn a_parameter_sweep_keeps_the_h_chosen_at_its_first_value() {
         assert_eq!(doc["points"].as_array().unwrap().len(), 3);
         (doc["harmonics"].as_u64().unwrap(), out.stderr)
     };
-    assert_eq!(run(&[]).0, 8);
-    let (h, stderr) = run(&["--harmonics", "auto:harmonics"]);
+    assert_eq!(run(&plain.scene(), &[]).0, 8);
+    let (h, stderr) = run(&plain.scene(), &["--harmonics", "auto:harmonics"]);
     assert_eq!(h, 32);
     let note = String::from_utf8_lossy(&stderr);
     assert!(
         note.contains("H = 32") && note.contains("not checked at the others"),
         "{note}"
     );
+    // The scene's automatic harmonics, and a fixed --harmonics over them.
+    assert_eq!(run(&automatic.scene(), &[]).0, 32);
+    assert_eq!(run(&automatic.scene(), &["--harmonics", "8"]).0, 8);
 }

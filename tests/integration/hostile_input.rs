@@ -1,6 +1,6 @@
 //! The hostile inputs of issue 13, each with the message and exit code it must give now: memory
-//! bombs refused before any allocation, meaningless fields refused with their field path,
-//! non-finite values stopped where they arise (never printed as `null`, NaN or inf).
+//! bombs refused before any allocation, meaningless fields refused with their field path (the
+//! non-finite values are in `hostile_non_finite`).
 
 use crate::common::hostile;
 
