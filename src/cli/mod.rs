@@ -159,6 +159,8 @@ impl SolverArgs {
             Method::Newton(o) => Method::Newton(o.with_tolerance(t).with_context(context)?),
             Method::Broyden(o) => Method::Broyden(o.with_tolerance(t).with_context(context)?),
             Method::Anderson(o) => Method::Anderson(o.with_tolerance(t).with_context(context)?),
+            // Exact: no residual tolerance to meet.
+            Method::PiecewiseExact(o) => Method::PiecewiseExact(o),
         })
     }
 }

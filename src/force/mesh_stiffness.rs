@@ -125,6 +125,12 @@ impl ForceLaw for MeshStiffness {
     fn is_linear_in_state(&self) -> bool {
         true
     }
+    fn is_piecewise_constant(&self) -> bool {
+        matches!(
+            self.profile,
+            MeshProfile::Rectangular { .. } | MeshProfile::Constant { .. }
+        )
+    }
     fn band_limited(&self, samples: usize, max_order: usize) -> Option<Box<dyn ForceLaw>> {
         let profile = self
             .profile

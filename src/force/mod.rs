@@ -235,6 +235,15 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
         false
     }
 
+    /// `true` if the law is linear in the state with coefficients `k(θ)`, `d(θ)` that are
+    /// constant between its [`time_breakpoints`](ForceLaw::time_breakpoints) (a rectangular
+    /// mesh stiffness): a scene of such laws and linear ones is linear time-invariant piece by
+    /// piece, and [`PiecewiseExact`](crate::solve::PiecewiseExact) solves it exactly.
+    /// Default: `false`.
+    fn is_piecewise_constant(&self) -> bool {
+        false
+    }
+
     /// Checks the parameters; `context` names the element in messages. Default: accepts.
     fn validate(&self, context: &str) -> Result<()> {
         let _ = context;

@@ -1,11 +1,17 @@
 //! The scene's `[solver]` table: the method and its options.
 
 use super::{Scene, SceneError};
-use crate::solve::{Anderson, Broyden, FixedPoint, Method, Newton};
+use crate::solve::{Anderson, Broyden, FixedPoint, Method, Newton, PiecewiseExact};
 use serde::Deserialize;
 
 /// Names of the solver methods.
-pub const METHODS: [&str; 4] = ["fixed_point", "newton", "broyden", "anderson"];
+pub const METHODS: [&str; 5] = [
+    "fixed_point",
+    "newton",
+    "broyden",
+    "anderson",
+    "piecewise_exact",
+];
 
 /// Solver settings; unset fields take the method's defaults.
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -103,6 +109,22 @@ impl SolverSpec {
                     o = o.with_max_iterations(m);
                 }
                 Method::Anderson(o)
+            }
+            "piecewise_exact" => {
+                // No iteration: the options of the iterative methods mean nothing here.
+                let unused = [
+                    ("gamma", self.gamma.is_some()),
+                    ("tolerance", self.tolerance.is_some()),
+                    ("max_iterations", self.max_iterations.is_some()),
+                    ("depth", self.depth.is_some()),
+                ];
+                if let Some((field, _)) = unused.iter().find(|(_, set)| *set) {
+                    return Err((
+                        format!("solver.{field}"),
+                        "not used by method `piecewise_exact` (an exact solution, no iteration): remove it".into(),
+                    ));
+                }
+                Method::PiecewiseExact(PiecewiseExact::new())
             }
             other => {
                 return Err((

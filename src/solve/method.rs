@@ -1,6 +1,6 @@
 //! A solver chosen at run time.
 
-use super::{Anderson, Broyden, FixedPoint, Newton};
+use super::{Anderson, Broyden, FixedPoint, Newton, PiecewiseExact};
 use crate::error::Result;
 use crate::residual::{HarmonicBalance, Workspace};
 use crate::solution::Solution;
@@ -18,6 +18,9 @@ pub enum Method {
     Broyden(Broyden),
     /// Anderson acceleration of the fixed point.
     Anderson(Anderson),
+    /// The exact periodic solution of a linear scene with piecewise-constant coefficients
+    /// (no iteration, no truncation; other scenes are refused).
+    PiecewiseExact(PiecewiseExact),
 }
 
 impl Method {
@@ -28,6 +31,7 @@ impl Method {
             Method::Newton(_) => "newton",
             Method::Broyden(_) => "broyden",
             Method::Anderson(_) => "anderson",
+            Method::PiecewiseExact(_) => "piecewise_exact",
         }
     }
 
@@ -43,6 +47,7 @@ impl Method {
             Method::Newton(o) => o.solve_from_option(hb, initial, ws),
             Method::Broyden(o) => o.solve_from_option(hb, initial, ws),
             Method::Anderson(o) => o.solve_from_option(hb, initial, ws),
+            Method::PiecewiseExact(o) => o.solve_from_option(hb, initial, ws),
         }
     }
 }

@@ -70,7 +70,7 @@ mod chord;
 mod cubic;
 mod dispatch;
 mod dopri;
-mod expm;
+pub(crate) mod expm;
 mod exponential;
 mod flow;
 mod generator;

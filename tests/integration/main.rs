@@ -47,6 +47,7 @@ mod modes;
 mod new_laws;
 mod nlvib_03;
 mod order_cuts;
+mod piecewise_exact;
 mod reference_solutions;
 mod report;
 mod scene_export;

@@ -1,0 +1,312 @@
+//! The pieces of a period between the coefficients' jumps, and the constant system on each.
+
+use super::factor::ComplexLu;
+use super::PiecewiseExact;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::stability::expm::Powers;
+use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64;
+use std::f64::consts::TAU;
+
+/// Angles closer than this (rad) are one breakpoint.
+const SAME_ANGLE: f64 = 1e-12;
+
+/// A piece `start <= θ < end` of the period with one configuration of coefficients.
+pub(super) struct Piece {
+    pub(super) start: f64,
+    pub(super) end: f64,
+    pub(super) configuration: usize,
+}
+
+impl Piece {
+    /// Its duration `(end - start) / Ω` in seconds.
+    pub(super) fn duration(&self, omega: f64) -> f64 {
+        (self.end - self.start) / omega
+    }
+}
+
+/// The constant system of one set of coefficients: `M q̈ + D q̇ + K q = f(θ)`.
+pub(super) struct Configuration {
+    pub(super) stiffness: DMatrix<f64>,
+    pub(super) damping: DMatrix<f64>,
+    /// `A = [0 ω_s I; -M⁻¹K/ω_s -M⁻¹D]` in the scaled state `(q, q̇/ω_s)`, with its powers.
+    pub(super) generator: Powers,
+    /// The steady state under the loads, `Q_k` for orders `k = 0..=K` (one-sided, `Q[k n + i]`).
+    steady: Vec<Complex64>,
+    n: usize,
+}
+
+/// The elements' `(k_e, d_e)` of a configuration with its `K`, `D`.
+type System = (Vec<(f64, f64)>, DMatrix<f64>, DMatrix<f64>);
+
+/// The pieces of the period and their configurations.
+pub(super) struct Schedule {
+    pub(super) n: usize,
+    pub(super) omega: f64,
+    pub(super) mass: DMatrix<f64>,
+    /// `ω_s`, the velocity scale of the generators' state.
+    velocity_scale: f64,
+    pub(super) configurations: Vec<Configuration>,
+    pub(super) pieces: Vec<Piece>,
+}
+
+impl Schedule {
+    /// Checks that the model is linear with piecewise-constant coefficients, cuts the period
+    /// at every element's time breakpoint and builds each distinct configuration.
+    pub(super) fn new(model: &Model, omega: f64) -> Result<Self> {
+        let n = model.n_dofs();
+        if n > PiecewiseExact::MAX_DOFS {
+            return Err(Error::TooLarge {
+                what: format!(
+                    "the exact piecewise solution of {n} DOFs (dense 2n × 2n monodromy matrix)"
+                ),
+                size: format!("{n} DOFs"),
+                limit: format!("{} DOFs", PiecewiseExact::MAX_DOFS),
+                advice: "use harmonic balance (newton, anderson) with the condensed formulation"
+                    .into(),
+            });
+        }
+        if let Some(e) = model.memory_element() {
+            return Err(Error::MemoryUnsupported {
+                analysis: "the exact piecewise solution (piecewise_exact)".into(),
+                element: e.name().into(),
+            });
+        }
+        for e in model.elements() {
+            let law = e.law();
+            if !(law.is_linear_time_invariant() || law.is_piecewise_constant()) {
+                return Err(Error::InvalidElement {
+                    context: format!("element `{}`", e.name()),
+                    reason: "method `piecewise_exact` needs every law linear in the state with coefficients constant between jumps in time (linear springs and dampers, constant or rectangular mesh stiffness); use harmonic balance (newton, anderson) for this scene".into(),
+                });
+            }
+        }
+        let dense = model.dense("piecewise_exact")?;
+        let mut breaks: Vec<f64> = model
+            .elements()
+            .iter()
+            .flat_map(|e| e.law().time_breakpoints())
+            .map(|t| t.rem_euclid(TAU))
+            .collect();
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup_by(|a, b| (*a - *b).abs() < SAME_ANGLE);
+        if breaks.len() > 1 && breaks[0] + TAU - breaks[breaks.len() - 1] < SAME_ANGLE {
+            breaks.pop();
+        }
+        if breaks.is_empty() {
+            breaks.push(0.0);
+        }
+        let mut schedule = Self {
+            n,
+            omega,
+            mass: dense.mass.clone(),
+            velocity_scale: 1.0,
+            configurations: Vec::new(),
+            pieces: Vec::new(),
+        };
+        let mut systems: Vec<System> = Vec::new();
+        for (i, &start) in breaks.iter().enumerate() {
+            let end = breaks.get(i + 1).copied().unwrap_or(breaks[0] + TAU);
+            let middle = 0.5 * (start + end);
+            let coefficients: Vec<(f64, f64)> = model
+                .elements()
+                .iter()
+                .map(|e| e.law().derivatives(middle, 0.0, 0.0))
+                .collect();
+            let configuration = match systems.iter().position(|s| s.0 == coefficients) {
+                Some(c) => c,
+                None => {
+                    let (mut k, mut d) = (dense.stiffness.clone(), dense.damping.clone());
+                    for (e, &(ke, de)) in model.elements().iter().zip(&coefficients) {
+                        if !(ke.is_finite() && de.is_finite()) {
+                            return Err(Error::NonFinite {
+                                what: format!(
+                                    "the coefficients of element `{}` at angle {middle}",
+                                    e.name()
+                                ),
+                            });
+                        }
+                        for &(i, wi) in e.weights() {
+                            for &(j, wj) in e.weights() {
+                                k[(i, j)] += ke * wi * wj;
+                                d[(i, j)] += de * wi * wj;
+                            }
+                        }
+                    }
+                    systems.push((coefficients, k, d));
+                    systems.len() - 1
+                }
+            };
+            schedule.pieces.push(Piece {
+                start,
+                end,
+                configuration,
+            });
+        }
+        let mass_lu = dense.mass.clone().lu();
+        let inverse = mass_lu
+            .try_inverse()
+            .ok_or_else(|| Error::MassNotPositiveDefinite {
+                reason: "singular (the exact piecewise solution needs M⁻¹)".into(),
+            })?;
+        // ω_s: the largest M⁻¹K diagonal's root, so that q and q̇/ω_s are of one size.
+        let scale = systems
+            .iter()
+            .flat_map(|(_, k, _)| {
+                let mk = &inverse * k;
+                (0..n).map(move |i| mk[(i, i)].abs()).collect::<Vec<_>>()
+            })
+            .fold(0.0f64, f64::max)
+            .sqrt();
+        schedule.velocity_scale = if scale.is_finite() && scale > 0.0 {
+            scale
+        } else {
+            1.0
+        };
+        for (_, k, d) in systems {
+            let config = schedule.configuration(model, &inverse, k, d)?;
+            schedule.configurations.push(config);
+        }
+        Ok(schedule)
+    }
+
+    /// The configuration of `k`, `d`: its scaled generator and its steady state.
+    fn configuration(
+        &self,
+        model: &Model,
+        mass_inverse: &DMatrix<f64>,
+        k: DMatrix<f64>,
+        d: DMatrix<f64>,
+    ) -> Result<Configuration> {
+        let n = self.n;
+        let ws = self.velocity_scale;
+        let mut a = DMatrix::zeros(2 * n, 2 * n);
+        let mk = mass_inverse * &k;
+        let md = mass_inverse * &d;
+        for i in 0..n {
+            a[(i, n + i)] = ws;
+            for j in 0..n {
+                a[(n + i, j)] = -mk[(i, j)] / ws;
+                a[(n + i, n + j)] = -md[(i, j)];
+            }
+        }
+        let orders = model.max_load_order();
+        let mut steady = vec![Complex64::new(0.0, 0.0); (orders + 1) * n];
+        let mut lu = ComplexLu::new(n);
+        for order in 0..=orders {
+            let block = &mut steady[order * n..(order + 1) * n];
+            for load in model.loads().iter().filter(|l| l.order == order) {
+                let sin = if order == 0 { 0.0 } else { load.sin };
+                block[load.dof] += Complex64::new(load.cos, -sin);
+            }
+            if block.iter().all(|c| c.norm() == 0.0) {
+                continue;
+            }
+            let s = Complex64::new(0.0, order as f64 * self.omega);
+            factor_at(&mut lu, &self.mass, &k, &d, s, order, self.omega)?;
+            lu.solve(block);
+        }
+        Ok(Configuration {
+            stiffness: k,
+            damping: d,
+            generator: Powers::new(a),
+            steady,
+            n,
+        })
+    }
+
+    /// The transition `x(t) = T x(0)` in `(q, q̇)` from `T_s` in the scaled state.
+    pub(super) fn unscale_transition(&self, scaled: &DMatrix<f64>) -> DMatrix<f64> {
+        let n = self.n;
+        let ws = self.velocity_scale;
+        DMatrix::from_fn(2 * n, 2 * n, |i, j| {
+            let row = if i < n { 1.0 } else { ws };
+            let column = if j < n { 1.0 } else { 1.0 / ws };
+            scaled[(i, j)] * row * column
+        })
+    }
+}
+
+/// Factors `Z(s) = K + sD + s²M` into `lu`; an error names the harmonic where it is singular.
+pub(super) fn factor_at(
+    lu: &mut ComplexLu,
+    mass: &DMatrix<f64>,
+    k: &DMatrix<f64>,
+    d: &DMatrix<f64>,
+    s: Complex64,
+    harmonic: usize,
+    omega: f64,
+) -> Result<()> {
+    let s2 = s * s;
+    let pivot = lu.factor(|i, j| k[(i, j)] + s * d[(i, j)] + s2 * mass[(i, j)]);
+    if pivot < crate::solve::lu::SINGULAR_PIVOT {
+        return Err(Error::SingularDynamicStiffness {
+            harmonic,
+            omega: harmonic as f64 * omega,
+            relative_pivot: pivot,
+            hint: "a piece of the period (between stiffness jumps) has an undamped resonance or a free rigid-body mode there; the exact piecewise solution needs every piece's Z regular: use harmonic balance".into(),
+        });
+    }
+    Ok(())
+}
+
+impl Configuration {
+    /// The steady state `(q, q̇)` at angle `θ`.
+    pub(super) fn steady_state(&self, theta: f64, omega: f64) -> DVector<f64> {
+        let n = self.n;
+        let mut x = DVector::zeros(2 * n);
+        for (order, block) in self.steady.chunks(n).enumerate() {
+            let e = Complex64::from_polar(1.0, order as f64 * theta);
+            let rate = Complex64::new(0.0, order as f64 * omega);
+            for (i, q) in block.iter().enumerate() {
+                x[i] += (q * e).re;
+                x[n + i] += (rate * q * e).re;
+            }
+        }
+        x
+    }
+
+    /// Adds the two-sided coefficient `c_l` of the steady state on `piece` (zero elsewhere):
+    /// `Σ_k c_k W(l - k)`, `W(j) = (1/2π) ∫_a^b e^{-ijθ} dθ`.
+    pub(super) fn add_steady_window(&self, piece: &Piece, l: usize, out: &mut [Complex64]) {
+        let n = self.n;
+        let (a, b) = (piece.start, piece.end);
+        let window = |j: i64| -> Complex64 {
+            if j == 0 {
+                Complex64::new((b - a) / TAU, 0.0)
+            } else {
+                let jf = j as f64;
+                (Complex64::from_polar(1.0, -jf * a) - Complex64::from_polar(1.0, -jf * b))
+                    / Complex64::new(0.0, TAU * jf)
+            }
+        };
+        for (order, block) in self.steady.chunks(n).enumerate() {
+            let k = order as i64;
+            let l = l as i64;
+            if order == 0 {
+                let w = window(l);
+                for (o, q) in out.iter_mut().zip(block) {
+                    *o += q * w;
+                }
+            } else {
+                let (wp, wm) = (window(l - k), window(l + k));
+                for (o, q) in out.iter_mut().zip(block) {
+                    *o += 0.5 * (q * wp + q.conj() * wm);
+                }
+            }
+        }
+    }
+
+    /// Factors `Z(lΩ)` of this configuration into `lu`.
+    pub(super) fn factor_dynamic_stiffness(
+        &self,
+        mass: &DMatrix<f64>,
+        s: Complex64,
+        lu: &mut ComplexLu,
+        harmonic: usize,
+        omega: f64,
+    ) -> Result<()> {
+        factor_at(lu, mass, &self.stiffness, &self.damping, s, harmonic, omega)
+    }
+}
