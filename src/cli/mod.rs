@@ -94,7 +94,7 @@ pub(crate) fn sweep_failure(e: hbal::Error, file: &str) -> Failure {
 /// The solver overrides of `solve`, `compare` and `sweep`.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub(crate) struct SolverArgs {
-    /// Solver: fixed_point, newton, broyden, anderson (default: the scene's).
+    /// Solver: fixed_point, newton, broyden, anderson, or piecewise_exact (the exact solution of a linear scene with piecewise-constant coefficients) (default: the scene's).
     #[arg(long)]
     pub(crate) method: Option<String>,
     /// Number of harmonics H, or `auto` to raise H until the estimated error is below the

@@ -83,8 +83,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             solve_seconds = started.elapsed().as_secs_f64();
             // The error of the harmonics, against the solution with 2H (module
             // hbal::solve::accuracy); none for an unconverged iterate.
-            let estimate = sol.is_converged().then(|| {
-                hbal::solve::estimate_error(&scene.model, &sol).map_err(|e| e.to_string())
+            let estimate = sol.is_converged().then(|| match scene.method {
+                // Exact harmonics: the estimate is what the basis lacks, and rounding.
+                hbal::solve::Method::PiecewiseExact(exact) => exact
+                    .solve_exact(&scene.model, &scene.basis)
+                    .map(|e| e.estimate)
+                    .map_err(|e| e.to_string()),
+                _ => hbal::solve::estimate_error(&scene.model, &sol).map_err(|e| e.to_string()),
             });
             (sol, estimate, None)
         }

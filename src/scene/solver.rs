@@ -47,6 +47,7 @@ pub fn check_tolerance(tolerance: f64) -> Result<(), String> {
 impl SolverSpec {
     /// The method, optionally overriding the name.
     pub(super) fn method(&self, name: Option<&str>) -> Result<Method, (String, String)> {
+        let requested = name;
         let name = name.or(self.method.as_deref()).unwrap_or("newton");
         let e = |field: &str, x: crate::Error| (format!("solver.{field}"), x.to_string());
         if let Some(t) = self.tolerance {
@@ -111,14 +112,17 @@ impl SolverSpec {
                 Method::Anderson(o)
             }
             "piecewise_exact" => {
-                // No iteration: the options of the iterative methods mean nothing here.
+                // No iteration: the options of the iterative methods mean nothing here. A
+                // scene that names this method and sets them is refused; a scene whose own
+                // method they belong to can still be run with `--method piecewise_exact`.
+                let overridden = requested.is_some_and(|n| Some(n) != self.method.as_deref());
                 let unused = [
                     ("gamma", self.gamma.is_some()),
                     ("tolerance", self.tolerance.is_some()),
                     ("max_iterations", self.max_iterations.is_some()),
                     ("depth", self.depth.is_some()),
                 ];
-                if let Some((field, _)) = unused.iter().find(|(_, set)| *set) {
+                if let Some((field, _)) = unused.iter().find(|(_, set)| *set && !overridden) {
                     return Err((
                         format!("solver.{field}"),
                         "not used by method `piecewise_exact` (an exact solution, no iteration): remove it".into(),

@@ -267,6 +267,9 @@ pub fn solve_auto(
             format!(">= the starting H {}", basis.harmonics()),
         ));
     }
+    if let Method::PiecewiseExact(exact) = method {
+        return auto_exact(model, basis, exact, auto);
+    }
     let n = model.n_dofs();
     let mut level_basis = scaled(&basis, basis.harmonics().max(1))?;
     let started = Instant::now();
@@ -304,5 +307,40 @@ pub fn solve_auto(
         }
         level_basis = *fine.basis();
         current = fine;
+    }
+}
+
+/// [`solve_auto`] with the exact piecewise solution: its harmonics `0..=H` are exact, so only
+/// what the periodic solution lacks above H decides; H doubles until that is within the
+/// tolerance (each level is one exact solve, no refinement).
+fn auto_exact(
+    model: &Model,
+    basis: HarmonicBasis,
+    exact: &crate::solve::PiecewiseExact,
+    auto: AutoHarmonics,
+) -> Result<AutoSolution> {
+    let started = Instant::now();
+    let mut level_basis = basis;
+    let mut levels = Vec::new();
+    loop {
+        let e = exact.solve_exact(model, &level_basis)?;
+        levels.push(Level {
+            harmonics: level_basis.harmonics(),
+            samples: level_basis.samples(),
+            estimate: auto.control.of(&e.estimate),
+            seconds: started.elapsed().as_secs_f64(),
+        });
+        let reached = auto.control.of(&e.estimate) <= auto.tolerance;
+        let next = 2 * level_basis.harmonics().max(1);
+        let capped = !reached && next > auto.max_harmonics;
+        if reached || capped {
+            return Ok(AutoSolution {
+                solution: e.solution,
+                estimate: e.estimate,
+                levels,
+                capped,
+            });
+        }
+        level_basis = scaled(&level_basis, next)?;
     }
 }

@@ -71,9 +71,11 @@ pub struct PiecewiseExact {}
 pub struct ExactSolution {
     /// The harmonics `0..=H` of the basis.
     pub solution: Solution,
-    /// `relative`: the content of the harmonics `H+1..=2H` (what the basis lacks), relative to
-    /// the harmonics `0..=2H`; `kept_harmonics`: the rounding of the periodicity solve
-    /// (machine precision times the condition of its pivots); both at least 1e-15.
+    /// `relative`: the content of the harmonics `H+1..=L` (what the basis lacks), relative to
+    /// the harmonics `0..=L`, where `L` (`reference_harmonics`) is `2H` or, where the work is
+    /// affordable, up to four times the highest natural frequency (estimated from the diagonal
+    /// of `M⁻¹K`), where the jumps ring; `kept_harmonics`: the rounding of the periodicity
+    /// solve (machine precision times the condition of its pivots); both at least 1e-15.
     pub estimate: ErrorEstimate,
 }
 
@@ -85,6 +87,13 @@ impl PiecewiseExact {
     /// The solver.
     pub fn new() -> Self {
         Self {}
+    }
+
+    /// `Ok` if this solver can solve `model`, else the error [`PiecewiseExact::solve_exact`]
+    /// would give (naming the element that is not linear with piecewise-constant
+    /// coefficients, or the size).
+    pub fn check(model: &Model) -> Result<()> {
+        schedule::check(model)
     }
 
     /// The method's run-time interface: the exact solution in the basis of `hb` (no start
@@ -108,9 +117,13 @@ impl PiecewiseExact {
         let n = schedule.n;
         let nu = basis.subharmonic();
         let h = basis.harmonics();
-        // Orders of Ω needed: those the basis holds (harmonic j is order j/ν) and up to twice
-        // as many for the estimate.
-        let orders = (2 * h) / nu;
+        // Orders of Ω computed: those the basis holds (harmonic j is order j/ν), and for the
+        // estimate of what it lacks at least twice as many, up to four times the highest
+        // natural frequency (where a jump's ringing lives) as far as the work budget allows.
+        let ringing = (4.0 * schedule.highest_frequency() / basis.omega()).ceil();
+        let per_order = schedule.configurations.len() * n * n * n + schedule.pieces.len() * n * n;
+        let affordable = (ESTIMATE_WORK / per_order.max(1) as f64).floor();
+        let orders = ((2 * h) as f64).max(ringing.min(affordable)) as usize / nu;
         let periodic = schedule.periodic_state()?;
         let exact = schedule.harmonics(&periodic, orders)?;
         let mut harmonics = vec![Complex64::new(0.0, 0.0); (h + 1) * n];
@@ -140,7 +153,7 @@ impl PiecewiseExact {
         let estimate = ErrorEstimate {
             relative: missing.max(rounding),
             kept_harmonics: rounding,
-            reference_harmonics: 2 * h,
+            reference_harmonics: orders * nu,
         };
         let solution = Solution {
             basis: *basis,
@@ -159,6 +172,10 @@ impl PiecewiseExact {
         Ok(ExactSolution { solution, estimate })
     }
 }
+
+/// The work (about `L × configurations × n³` operations) the estimate may spend on orders
+/// beyond 2H.
+const ESTIMATE_WORK: f64 = 2e7;
 
 /// The periodic state at the start of every piece.
 struct Periodic {

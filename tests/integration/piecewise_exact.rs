@@ -68,3 +68,129 @@ fn low_speeds_and_jumps_between_samples_against_the_time_domain() {
         );
     }
 }
+
+/// `hbal` run on `args`, its exit code and its standard output and error.
+fn run(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = crate::common::hbal(args);
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scene(name: &str) -> String {
+    format!("{}/examples/scenes/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn hbal_solve_and_compare_with_the_exact_method() {
+    let low = scene("two_shaft_60rpm.toml");
+    let (code, out, err) = run(&[
+        "solve",
+        &low,
+        "--method",
+        "piecewise_exact",
+        "--json",
+        "--no-stability",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(json["method"], "piecewise_exact");
+    let estimate = &json["error_estimate"];
+    // Exact harmonics; what H = 32 lacks (the ringing near harmonic 771) is not hidden.
+    assert!(
+        estimate["kept_harmonics"].as_f64().unwrap() < 1e-12,
+        "{estimate}"
+    );
+    assert!(estimate["relative"].as_f64().unwrap() > 1e-2, "{estimate}");
+    assert!(
+        estimate["reference_harmonics"].as_u64().unwrap() > 771,
+        "{estimate}"
+    );
+    // compare: the exact method is one of the methods on a linear scene, and agrees with the
+    // time domain far below harmonic balance at H = 32.
+    let (code, out, err) = run(&["compare", &scene("two_shaft_600rpm.toml"), "--json"]);
+    assert_eq!(code, Some(0), "{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let methods = json["methods"].as_array().unwrap();
+    let error_of = |name: &str| {
+        methods
+            .iter()
+            .find(|m| m["method"] == name)
+            .and_then(|m| m["error_vs_time_domain"].as_f64())
+            .unwrap_or_else(|| panic!("{name} missing: {out}"))
+    };
+    assert!(error_of("piecewise_exact") < 1e-8, "{out}");
+    assert!(error_of("newton") > 1e-3, "{out}");
+    // ... and left out on a nonlinear one, which still compares the others.
+    let (code, out, err) = run(&["compare", &scene("duffing.toml"), "--json"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        !out.contains("piecewise_exact") && out.contains("newton"),
+        "{out}"
+    );
+}
+
+#[test]
+fn the_exact_method_refuses_what_it_cannot_solve() {
+    // A nonlinear law, by element.
+    let (code, _, err) = run(&[
+        "solve",
+        &scene("duffing.toml"),
+        "--method",
+        "piecewise_exact",
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("element `spring`") && err.contains("piecewise_exact"),
+        "{err}"
+    );
+    // A scene that names the method with an iterative method's option, by field.
+    let dir = std::env::temp_dir().join(format!("hbal-exact-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(scene("two_shaft_60rpm.toml"))
+        .unwrap()
+        .replace("method = \"newton\"", "method = \"piecewise_exact\"");
+    assert!(text.contains("piecewise_exact") && text.contains("tolerance = 1e-10"));
+    let path = dir.join("two_shaft.toml");
+    std::fs::write(&path, &text).unwrap();
+    let (code, _, err) = run(&["solve", path.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("solver.tolerance") && err.contains("not used"),
+        "{err}"
+    );
+    // Without it the scene runs.
+    std::fs::write(&path, text.replace("tolerance = 1e-10\n", "")).unwrap();
+    let (code, out, err) = run(&["solve", path.to_str().unwrap(), "--no-stability"]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("piecewise_exact"), "{out}");
+}
+
+#[test]
+fn automatic_harmonics_with_the_exact_method() {
+    use hbal::solve::{solve_auto, AutoHarmonics, Control, Method};
+    let r = reference("seed_rect_6000rpm.json");
+    let shaft = TwoShaft::new(6000.0);
+    let model = shaft.model().unwrap();
+    let start = HarmonicBasis::new(shaft.mesh_omega(), 8).unwrap();
+    let method = Method::PiecewiseExact(PiecewiseExact::new());
+    // The harmonics 0..H are exact: the first level is enough.
+    let auto = AutoHarmonics {
+        control: Control::Harmonics,
+        ..AutoHarmonics::default()
+    };
+    let a = solve_auto(&model, start, &method, auto).unwrap();
+    assert_eq!(a.levels.len(), 1);
+    assert!(a.estimate.kept_harmonics < 1e-9);
+    // The periodic solution: H doubles until what it lacks is below 1e-6 (the rectangular
+    // stiffness's harmonics decay like l^-3: H = 512, as harmonic balance needs).
+    let a = solve_auto(&model, start, &method, AutoHarmonics::default()).unwrap();
+    let hs: Vec<usize> = a.levels.iter().map(|l| l.harmonics).collect();
+    assert_eq!(hs, [8, 16, 32, 64, 128, 256, 512], "{:?}", a.levels);
+    assert!(!a.capped && a.estimate.relative <= 1e-6, "{:?}", a.estimate);
+    let err = relative_error(a.solution.harmonics(), &r.harmonics, 1, 32);
+    assert!(err < 1e-10, "{err:.2e}");
+}

@@ -56,32 +56,7 @@ impl Schedule {
     /// at every element's time breakpoint and builds each distinct configuration.
     pub(super) fn new(model: &Model, omega: f64) -> Result<Self> {
         let n = model.n_dofs();
-        if n > PiecewiseExact::MAX_DOFS {
-            return Err(Error::TooLarge {
-                what: format!(
-                    "the exact piecewise solution of {n} DOFs (dense 2n × 2n monodromy matrix)"
-                ),
-                size: format!("{n} DOFs"),
-                limit: format!("{} DOFs", PiecewiseExact::MAX_DOFS),
-                advice: "use harmonic balance (newton, anderson) with the condensed formulation"
-                    .into(),
-            });
-        }
-        if let Some(e) = model.memory_element() {
-            return Err(Error::MemoryUnsupported {
-                analysis: "the exact piecewise solution (piecewise_exact)".into(),
-                element: e.name().into(),
-            });
-        }
-        for e in model.elements() {
-            let law = e.law();
-            if !(law.is_linear_time_invariant() || law.is_piecewise_constant()) {
-                return Err(Error::InvalidElement {
-                    context: format!("element `{}`", e.name()),
-                    reason: "method `piecewise_exact` needs every law linear in the state with coefficients constant between jumps in time (linear springs and dampers, constant or rectangular mesh stiffness); use harmonic balance (newton, anderson) for this scene".into(),
-                });
-            }
-        }
+        check(model)?;
         let dense = model.dense("piecewise_exact")?;
         let mut breaks: Vec<f64> = model
             .elements()
@@ -216,6 +191,12 @@ impl Schedule {
         })
     }
 
+    /// The highest natural frequency in rad/s, estimated as the root of the largest
+    /// diagonal entry of `M⁻¹K` over the configurations (1 if there is none).
+    pub(super) fn highest_frequency(&self) -> f64 {
+        self.velocity_scale
+    }
+
     /// The transition `x(t) = T x(0)` in `(q, q̇)` from `T_s` in the scaled state.
     pub(super) fn unscale_transition(&self, scaled: &DMatrix<f64>) -> DMatrix<f64> {
         let n = self.n;
@@ -226,6 +207,39 @@ impl Schedule {
             scaled[(i, j)] * row * column
         })
     }
+}
+
+/// Whether [`PiecewiseExact`] can solve `model`: at most [`PiecewiseExact::MAX_DOFS`] DOFs,
+/// no law with memory, every law linear time-invariant or piecewise constant
+/// ([`ForceLaw::is_piecewise_constant`](crate::force::ForceLaw::is_piecewise_constant)).
+pub(super) fn check(model: &Model) -> Result<()> {
+    let n = model.n_dofs();
+    if n > PiecewiseExact::MAX_DOFS {
+        return Err(Error::TooLarge {
+            what: format!(
+                "the exact piecewise solution of {n} DOFs (dense 2n × 2n monodromy matrix)"
+            ),
+            size: format!("{n} DOFs"),
+            limit: format!("{} DOFs", PiecewiseExact::MAX_DOFS),
+            advice: "use harmonic balance (newton, anderson) with the condensed formulation".into(),
+        });
+    }
+    if let Some(e) = model.memory_element() {
+        return Err(Error::MemoryUnsupported {
+            analysis: "the exact piecewise solution (piecewise_exact)".into(),
+            element: e.name().into(),
+        });
+    }
+    for e in model.elements() {
+        let law = e.law();
+        if !(law.is_linear_time_invariant() || law.is_piecewise_constant()) {
+            return Err(Error::InvalidElement {
+                context: format!("element `{}`", e.name()),
+                reason: "method `piecewise_exact` needs every law linear in the state with coefficients constant between jumps in time (linear springs and dampers, constant or rectangular mesh stiffness); use harmonic balance (newton, anderson) for this scene".into(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Factors `Z(s) = K + sD + s²M` into `lu`; an error names the harmonic where it is singular.
