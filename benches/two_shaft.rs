@@ -2,7 +2,9 @@
 //! - two-shaft at 6000 rpm, H = 32, 3 fixed-point iterations, plans built beforehand: <= 20 µs;
 //! - HB cost flat across speed: 60000 rpm within 2x of 60 rpm;
 //! - speed-up over the time-domain reference at the same error at 60000 rpm;
-//! - issue 3: Newton on the backlash gear pair, H = 32, <= 50 µs per solve.
+//! - issue 3: Newton on the backlash gear pair, H = 32, <= 50 µs per solve;
+//! - issue 9: the exact piecewise solution (harmonics 0..32 exact) against the time domain to
+//!   1e-6 across speed, the two-shaft model at 60 rpm included.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use hbal::catalog::TwoShaft;
@@ -89,6 +91,23 @@ fn time_domain(c: &mut Criterion) {
     group.finish();
 }
 
+/// The exact piecewise solution with H = 32 (its estimate's orders up to 4 times the natural
+/// frequency included), at the speeds of `time_domain`.
+fn piecewise_exact(c: &mut Criterion) {
+    use hbal::solve::PiecewiseExact;
+    let mut group = c.benchmark_group("piecewise_exact_H32");
+    for rpm in [60.0, 600.0, 6000.0, 60000.0] {
+        let case = TwoShaft::new(rpm);
+        let model = case.model().unwrap();
+        let basis = HarmonicBasis::new(case.mesh_omega(), 32).unwrap();
+        let exact = PiecewiseExact::new();
+        group.bench_with_input(BenchmarkId::from_parameter(rpm), &rpm, |b, _| {
+            b.iter(|| black_box(exact.solve_exact(&model, &basis).unwrap()))
+        });
+    }
+    group.finish();
+}
+
 /// Issue 3: Newton on the backlash gear pair (W = 0.7), 1 DOF, H = 32: <= 50 µs per solve; and
 /// every method on it.
 fn solvers_on_backlash(c: &mut Criterion) {
@@ -115,6 +134,7 @@ criterion_group!(
     three_iterations,
     flat_across_speed,
     time_domain,
+    piecewise_exact,
     solvers_on_backlash
 );
 criterion_main!(benches);

@@ -55,9 +55,11 @@ use std::f64::consts::TAU;
 use std::time::Instant;
 
 mod factor;
+mod phasors;
 mod schedule;
 
 use factor::ComplexLu;
+use phasors::EdgePhasors;
 use schedule::Schedule;
 
 /// The exact solver for linear scenes with piecewise-constant coefficients
@@ -251,22 +253,33 @@ impl Schedule {
         let mut lu = ComplexLu::new(n);
         let mut rhs = vec![Complex64::new(0.0, 0.0); n];
         let scale = self.omega / TAU;
+        let loads = self.model_load_orders;
+        let mut edges: Vec<EdgePhasors> = self
+            .pieces
+            .iter()
+            .map(|p| EdgePhasors::new(p.start, p.end, loads))
+            .collect();
         for l in 0..=orders {
             let s = Complex64::new(0.0, l as f64 * self.omega);
             let two_sided = &mut out[l * n..(l + 1) * n];
+            for e in edges.iter_mut() {
+                e.go_to(l);
+            }
             for (ci, config) in self.configurations.iter().enumerate() {
                 let mut factored = false;
                 for (p, piece) in self.pieces.iter().enumerate() {
                     if piece.configuration != ci {
                         continue;
                     }
-                    config.add_steady_window(piece, l, two_sided);
+                    let edge = &edges[p];
+                    config.add_steady_window(edge, two_sided);
                     if !factored {
                         config.factor_dynamic_stiffness(&self.mass, s, &mut lu, l, self.omega)?;
                         factored = true;
                     }
                     // r = e^{-sτ} Φ h - h, then y = -Z⁻¹ (M r_v + (D + sM) r_q).
-                    let decay = (-s * piece.duration(self.omega)).exp();
+                    // e^{-sτ} = e^{-il(b - a)}.
+                    let decay = edge.eb * edge.ea.conj();
                     let (h, e) = (&periodic.free_start[p], &periodic.free_end[p]);
                     let r = |i: usize| decay * e[i] - h[i];
                     for (i, b) in rhs.iter_mut().enumerate() {
@@ -279,7 +292,7 @@ impl Schedule {
                         *b = -acc;
                     }
                     lu.solve(&mut rhs);
-                    let phase = Complex64::from_polar(scale, -(l as f64) * piece.start);
+                    let phase = scale * edge.ea;
                     for (o, y) in two_sided.iter_mut().zip(&rhs) {
                         *o += phase * y;
                     }

@@ -1,6 +1,7 @@
 //! The pieces of a period between the coefficients' jumps, and the constant system on each.
 
 use super::factor::ComplexLu;
+use super::phasors::EdgePhasors;
 use super::PiecewiseExact;
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -49,6 +50,8 @@ pub(super) struct Schedule {
     velocity_scale: f64,
     pub(super) configurations: Vec<Configuration>,
     pub(super) pieces: Vec<Piece>,
+    /// The highest load order K.
+    pub(super) model_load_orders: usize,
 }
 
 impl Schedule {
@@ -79,6 +82,7 @@ impl Schedule {
             velocity_scale: 1.0,
             configurations: Vec::new(),
             pieces: Vec::new(),
+            model_load_orders: model.max_load_order(),
         };
         let mut systems: Vec<System> = Vec::new();
         for (i, &start) in breaks.iter().enumerate() {
@@ -281,30 +285,20 @@ impl Configuration {
         x
     }
 
-    /// Adds the two-sided coefficient `c_l` of the steady state on `piece` (zero elsewhere):
-    /// `Σ_k c_k W(l - k)`, `W(j) = (1/2π) ∫_a^b e^{-ijθ} dθ`.
-    pub(super) fn add_steady_window(&self, piece: &Piece, l: usize, out: &mut [Complex64]) {
+    /// Adds the two-sided coefficient `c_l` of the steady state on a piece (zero elsewhere)
+    /// at the order `l` of `edges`, the piece's phasors: `Σ_k c_k W(l - k)`,
+    /// `W(j) = (1/2π) ∫_a^b e^{-ijθ} dθ`.
+    pub(super) fn add_steady_window(&self, edges: &EdgePhasors, out: &mut [Complex64]) {
         let n = self.n;
-        let (a, b) = (piece.start, piece.end);
-        let window = |j: i64| -> Complex64 {
-            if j == 0 {
-                Complex64::new((b - a) / TAU, 0.0)
-            } else {
-                let jf = j as f64;
-                (Complex64::from_polar(1.0, -jf * a) - Complex64::from_polar(1.0, -jf * b))
-                    / Complex64::new(0.0, TAU * jf)
-            }
-        };
         for (order, block) in self.steady.chunks(n).enumerate() {
             let k = order as i64;
-            let l = l as i64;
             if order == 0 {
-                let w = window(l);
+                let w = edges.window(0);
                 for (o, q) in out.iter_mut().zip(block) {
                     *o += q * w;
                 }
             } else {
-                let (wp, wm) = (window(l - k), window(l + k));
+                let (wp, wm) = (edges.window(k), edges.window(-k));
                 for (o, q) in out.iter_mut().zip(block) {
                     *o += 0.5 * (q * wp + q.conj() * wm);
                 }
