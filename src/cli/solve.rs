@@ -94,6 +94,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             (sol, estimate, None)
         }
     };
+    hint_exact(&scene, estimate.as_ref());
     // Stability of a converged orbit (an unconverged iterate is no orbit to judge).
     let started = Instant::now();
     // Laws with memory: no multipliers rather than wrong ones (not a failure of the solve).
@@ -337,4 +338,23 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     } else {
         1
     })
+}
+
+/// A note where harmonic balance leaves the harmonics 0..H of a scene with an error above 1e-6
+/// that the exact piecewise solution would solve exactly (linear, piecewise-constant
+/// coefficients: a rectangular mesh stiffness at low speed).
+fn hint_exact(
+    scene: &hbal::scene::Scene,
+    estimate: Option<&Result<hbal::solve::ErrorEstimate, String>>,
+) {
+    let Some(Ok(e)) = estimate else { return };
+    if e.kept_harmonics > 1e-6
+        && !matches!(scene.method, hbal::solve::Method::PiecewiseExact(_))
+        && hbal::solve::PiecewiseExact::check(&scene.model).is_ok()
+    {
+        eprintln!(
+            "note: {}: the harmonics 0..H are estimated {:.1e} off; this scene is linear with piecewise-constant coefficients: `--method piecewise_exact` gives them exactly",
+            scene.file, e.kept_harmonics
+        );
+    }
 }

@@ -79,6 +79,10 @@ pub struct ExactSolution {
     /// of `M⁻¹K`), where the jumps ring; `kept_harmonics`: the rounding of the periodicity
     /// solve (machine precision times the condition of its pivots); both at least 1e-15.
     pub estimate: ErrorEstimate,
+    /// The Floquet multipliers, the eigenvalues of the monodromy matrix `Φ` in `(q, q̇)`, by
+    /// decreasing modulus: exact to rounding (a linear scene's stability does not depend on the
+    /// orbit). All inside the unit circle: the orbit is stable.
+    pub multipliers: Vec<Complex64>,
 }
 
 impl PiecewiseExact {
@@ -171,7 +175,12 @@ impl PiecewiseExact {
             },
             wall_time: start.elapsed(),
         };
-        Ok(ExactSolution { solution, estimate })
+        let multipliers = periodic.multipliers.clone();
+        Ok(ExactSolution {
+            solution,
+            estimate,
+            multipliers,
+        })
     }
 }
 
@@ -189,6 +198,8 @@ struct Periodic {
     closure: f64,
     /// Largest over smallest pivot of the LU of `I - Φ`.
     condition: f64,
+    /// The eigenvalues of `Φ`, by decreasing modulus.
+    multipliers: Vec<Complex64>,
 }
 
 impl Schedule {
@@ -211,6 +222,8 @@ impl Schedule {
             phi = &t * phi;
             transitions.push(t);
         }
+        let mut multipliers: Vec<Complex64> = phi.complex_eigenvalues().iter().copied().collect();
+        multipliers.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
         let mut a = DMatrix::<f64>::identity(m, m) - &phi;
         let mut perm = vec![0; m];
         let regular = super::lu::factor_in_place(&mut a, &mut perm);
@@ -242,6 +255,7 @@ impl Schedule {
             free_end,
             closure,
             condition: hi / lo,
+            multipliers,
         })
     }
 
