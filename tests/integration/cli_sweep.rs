@@ -318,3 +318,63 @@ fn sweep_reports_interpolated_folds() {
     csv_folds.sort_by(f64::total_cmp);
     assert!((csv_folds[0] - folds[0]).abs() < 1e-9 && (csv_folds[1] - folds[1]).abs() < 1e-9);
 }
+
+/// A `--parameter` sweep of the speed itself solves each point at that point's Ω: the two-shaft
+/// model's max |q| at 5000 and 7000 rpm equals `hbal solve` of the scene at those speeds (a
+/// sweep that kept the first value's Ω, or the scene's, would be 0.4 % off at 5000 or 7000 rpm).
+#[test]
+fn a_parameter_sweep_of_the_speed_solves_at_each_speed() {
+    let scene = scenes_dir().join("two_shaft_6000rpm.toml");
+    let out = hbal(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--parameter",
+        "fundamental.rpm",
+        "--from",
+        "5000",
+        "--to",
+        "7000",
+        "--points",
+        "3",
+        "--json",
+        "--no-stability",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let json = json_of(&out);
+    let points = json["points"].as_array().unwrap();
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("\nrpm = 6000\n"));
+    let dir = temp_dir("parameter-speed");
+    let mut amplitudes = Vec::new();
+    for (point, rpm) in points.iter().zip(["5000", "6000", "7000"]) {
+        assert_eq!(
+            point["parameter"].as_f64().unwrap(),
+            rpm.parse::<f64>().unwrap()
+        );
+        let path = dir.join(format!("two_shaft_{rpm}.toml"));
+        std::fs::write(
+            &path,
+            text.replace("\nrpm = 6000\n", &format!("\nrpm = {rpm}\n")),
+        )
+        .unwrap();
+        let solved = json_of(&hbal(&[
+            "solve",
+            path.to_str().unwrap(),
+            "--json",
+            "--no-stability",
+        ]));
+        let want = solved["dofs"][0]["max_abs"].as_f64().unwrap();
+        let got = point["max_abs"][0].as_f64().unwrap();
+        assert!(
+            (got - want).abs() < 1e-9 * want,
+            "{rpm} rpm: {got:e} against {want:e}"
+        );
+        amplitudes.push(got);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    // The speeds give different answers (what the comparison above relies on).
+    assert!(
+        (amplitudes[0] - amplitudes[2]).abs() > 1e-3 * amplitudes[1],
+        "{amplitudes:?}"
+    );
+}
