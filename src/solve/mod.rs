@@ -14,7 +14,7 @@ mod fixed_point;
 pub mod lu;
 mod method;
 mod newton;
-mod piecewise;
+pub mod piecewise;
 mod problem;
 mod run;
 mod start;
