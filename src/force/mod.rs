@@ -235,11 +235,11 @@ pub trait ForceLaw: std::fmt::Debug + Send + Sync {
         false
     }
 
-    /// `true` if the law is linear in the state with coefficients `k(θ)`, `d(θ)` that are
-    /// constant between its [`time_breakpoints`](ForceLaw::time_breakpoints) (a rectangular
-    /// mesh stiffness): a scene of such laws and linear ones is linear time-invariant piece by
-    /// piece, and [`PiecewiseExact`](crate::solve::PiecewiseExact) solves it exactly.
-    /// Default: `false`.
+    /// `true` if the law is `k(θ) u + d(θ) u̇ + f_0(θ)` with `k`, `d` and the force at rest
+    /// `f_0` constant between its [`time_breakpoints`](ForceLaw::time_breakpoints) (a
+    /// rectangular mesh stiffness, also with an offset): a scene of such laws and linear ones
+    /// is linear time-invariant piece by piece, and
+    /// [`PiecewiseExact`](crate::solve::PiecewiseExact) solves it exactly. Default: `false`.
     fn is_piecewise_constant(&self) -> bool {
         false
     }

@@ -131,6 +131,14 @@ impl ForceLaw for Offset {
         // carries every element's static offset as a load (also for LTI elements).
         self.law.is_linear_time_invariant()
     }
+    fn is_linear_in_state(&self) -> bool {
+        // Not in the state alone: the shift adds the force at rest -k(θ) u0.
+        false
+    }
+    fn is_piecewise_constant(&self) -> bool {
+        // The shift keeps the coefficients; the force at rest -k(θ) u0 jumps with them.
+        self.law.is_piecewise_constant()
+    }
     fn validate(&self, context: &str) -> Result<()> {
         check_finite(context, "offset", self.offset)?;
         self.law.validate(context)

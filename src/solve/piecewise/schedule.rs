@@ -38,8 +38,9 @@ pub(super) struct Configuration {
     n: usize,
 }
 
-/// The elements' `(k_e, d_e)` of a configuration with its `K`, `D`.
-type System = (Vec<(f64, f64)>, DMatrix<f64>, DMatrix<f64>);
+/// A configuration's elements' `(k_e, d_e, f_e(θ, 0, 0))` (the last the force at rest of a
+/// law with a static offset, a preloaded spring), with its `K`, `D`.
+type System = (Vec<(f64, f64, f64)>, DMatrix<f64>, DMatrix<f64>);
 
 /// The pieces of the period and their configurations.
 pub(super) struct Schedule {
@@ -88,17 +89,20 @@ impl Schedule {
         for (i, &start) in breaks.iter().enumerate() {
             let end = breaks.get(i + 1).copied().unwrap_or(breaks[0] + TAU);
             let middle = 0.5 * (start + end);
-            let coefficients: Vec<(f64, f64)> = model
+            let coefficients: Vec<(f64, f64, f64)> = model
                 .elements()
                 .iter()
-                .map(|e| e.law().derivatives(middle, 0.0, 0.0))
+                .map(|e| {
+                    let (k, d) = e.law().derivatives(middle, 0.0, 0.0);
+                    (k, d, e.law().force(middle, 0.0, 0.0))
+                })
                 .collect();
             let configuration = match systems.iter().position(|s| s.0 == coefficients) {
                 Some(c) => c,
                 None => {
                     let (mut k, mut d) = (dense.stiffness.clone(), dense.damping.clone());
-                    for (e, &(ke, de)) in model.elements().iter().zip(&coefficients) {
-                        if !(ke.is_finite() && de.is_finite()) {
+                    for (e, &(ke, de, fe)) in model.elements().iter().zip(&coefficients) {
+                        if !(ke.is_finite() && de.is_finite() && fe.is_finite()) {
                             return Err(Error::NonFinite {
                                 what: format!(
                                     "the coefficients of element `{}` at angle {middle}",
@@ -143,18 +147,21 @@ impl Schedule {
         } else {
             1.0
         };
-        for (_, k, d) in systems {
-            let config = schedule.configuration(model, &inverse, k, d)?;
+        for (coefficients, k, d) in systems {
+            let rest: Vec<f64> = coefficients.iter().map(|c| c.2).collect();
+            let config = schedule.configuration(model, &inverse, &rest, k, d)?;
             schedule.configurations.push(config);
         }
         Ok(schedule)
     }
 
-    /// The configuration of `k`, `d`: its scaled generator and its steady state.
+    /// The configuration of `k`, `d` with the elements' forces at rest `rest`: its scaled
+    /// generator and its steady state (the forces at rest are static loads `-w_e f_e`).
     fn configuration(
         &self,
         model: &Model,
         mass_inverse: &DMatrix<f64>,
+        rest: &[f64],
         k: DMatrix<f64>,
         d: DMatrix<f64>,
     ) -> Result<Configuration> {
@@ -178,6 +185,13 @@ impl Schedule {
             for load in model.loads().iter().filter(|l| l.order == order) {
                 let sin = if order == 0 { 0.0 } else { load.sin };
                 block[load.dof] += Complex64::new(load.cos, -sin);
+            }
+            if order == 0 {
+                for (e, &f) in model.elements().iter().zip(rest) {
+                    for &(i, w) in e.weights() {
+                        block[i] -= w * f;
+                    }
+                }
             }
             if block.iter().all(|c| c.norm() == 0.0) {
                 continue;
