@@ -159,8 +159,14 @@ impl SolverArgs {
             Method::Newton(o) => Method::Newton(o.with_tolerance(t).with_context(context)?),
             Method::Broyden(o) => Method::Broyden(o.with_tolerance(t).with_context(context)?),
             Method::Anderson(o) => Method::Anderson(o.with_tolerance(t).with_context(context)?),
-            // Exact: no residual tolerance to meet.
-            Method::PiecewiseExact(o) => Method::PiecewiseExact(o),
+            // Exact: no residual tolerance to meet (a scene's `tolerance` is refused too).
+            Method::PiecewiseExact(_) => {
+                return Err(anyhow::anyhow!(
+                    "{}: method piecewise_exact has no residual tolerance (its harmonics are exact to rounding); drop --tolerance",
+                    context()
+                )
+                .into())
+            }
         })
     }
 }

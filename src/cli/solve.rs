@@ -72,6 +72,19 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 Some((auto, a.levels, a.capped)),
             )
         }
+        None if matches!(scene.method, hbal::solve::Method::PiecewiseExact(_)) => {
+            if let Some(file) = opts.start {
+                eprintln!(
+                    "note: --start {} is not used: the exact piecewise solution needs no start",
+                    file.display()
+                );
+            }
+            let exact = hbal::solve::PiecewiseExact::new()
+                .solve_exact(&scene.model, &scene.basis)
+                .map_err(|e| super::failure(e, &scene.file))?;
+            solve_seconds = started.elapsed().as_secs_f64();
+            (exact.solution, Some(Ok(exact.estimate)), None)
+        }
         None => {
             let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
                 .with_context(|| scene.file.clone())?;
@@ -83,13 +96,8 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             solve_seconds = started.elapsed().as_secs_f64();
             // The error of the harmonics, against the solution with 2H (module
             // hbal::solve::accuracy); none for an unconverged iterate.
-            let estimate = sol.is_converged().then(|| match scene.method {
-                // Exact harmonics: the estimate is what the basis lacks, and rounding.
-                hbal::solve::Method::PiecewiseExact(exact) => exact
-                    .solve_exact(&scene.model, &scene.basis)
-                    .map(|e| e.estimate)
-                    .map_err(|e| e.to_string()),
-                _ => hbal::solve::estimate_error(&scene.model, &sol).map_err(|e| e.to_string()),
+            let estimate = sol.is_converged().then(|| {
+                hbal::solve::estimate_error(&scene.model, &sol).map_err(|e| e.to_string())
             });
             (sol, estimate, None)
         }
@@ -157,7 +165,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             "truncation_estimate": sol.truncation_estimate(),
             "error_estimate": match &estimate {
                 None => serde_json::Value::Null,
-                Some(Ok(e)) => json!({"relative": e.relative, "kept_harmonics": e.kept_harmonics, "reference_harmonics": e.reference_harmonics}),
+                Some(Ok(e)) => json!({"relative": e.relative, "kept_harmonics": e.kept_harmonics, "reference_harmonics": e.reference_harmonics, "lower_bound": e.lower_bound}),
                 Some(Err(e)) => json!({"error": e}),
             },
             "auto_harmonics": auto.as_ref().map(|(a, levels, capped)| json!({
@@ -200,7 +208,8 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             sol.basis().samples(),
             match &estimate {
                 Some(Ok(e)) => format!(
-                    "error estimate {:.1e}, of harmonics 0..{} {:.1e} (against H = {})",
+                    "error estimate {}{:.1e}, of harmonics 0..{} {:.1e} (against H = {})",
+                    if e.lower_bound { "at least " } else { "" },
                     e.relative,
                     sol.basis().harmonics(),
                     e.kept_harmonics,

@@ -40,6 +40,11 @@ pub struct ErrorEstimate {
     pub kept_harmonics: f64,
     /// The H of the finer solution it was estimated against (2H).
     pub reference_harmonics: usize,
+    /// `relative` counts only the harmonics up to `reference_harmonics`, short of where the
+    /// solution is known to have content (the exact piecewise solution beyond its work
+    /// budget): the true error may be larger.
+    #[serde(default)]
+    pub lower_bound: bool,
 }
 
 /// The basis with `harmonics` harmonics at the Ω and ν of `basis`, with as many samples per
@@ -135,6 +140,7 @@ fn compare(coarse: &Solution, fine: &Solution, n: usize) -> ErrorEstimate {
         relative: relative_error(coarse.harmonics(), fine.harmonics(), n, h2).max(FLOOR),
         kept_harmonics: relative_error(coarse.harmonics(), fine.harmonics(), n, h).max(FLOOR),
         reference_harmonics: h2,
+        lower_bound: false,
     }
 }
 

@@ -20,13 +20,23 @@
 //! period `x(T) = Φ x(0) + c`, and periodicity gives `(I - Φ) x(0) = c`: one dense solve of
 //! size 2n (`Φ` is the monodromy matrix; `I - Φ` is regular unless a Floquet multiplier is 1).
 //!
-//! **Harmonics.** `Q_l = (Ω/π) ∫_0^T q(t) e^{-ilΩt} dt` (one-sided, `Q_0` the mean) piece by
-//! piece, exactly: the steady-state parts through the Fourier coefficients of the piece's
+//! **Harmonics.** `Q_l = (Ω/π) ∫_0^T q(t) e^{-ilΩt} dt` for `l >= 1` and the mean
+//! `Q_0 = (Ω/2π) ∫_0^T q(t) dt` (one-sided), piece by piece, exactly: the steady-state parts through the Fourier coefficients of the piece's
 //! window, the free motion through
 //! `∫_0^τ e^{(A - s) r} dr h = (A - s)⁻¹ (e^{-sτ} Φ h - h)`, `s = ilΩ`, whose displacement
 //! part is `y = -Z_p(lΩ)⁻¹ (M r_v + (D_p + sM) r_q)` for `r = (r_q, r_v)`: one complex n × n
 //! solve per harmonic and piece configuration. Nothing is truncated and nothing sampled; the
 //! harmonics `0..=H` are exact to rounding, at any speed.
+//!
+//! **Scaling.** The exponentials, `Φ` and the periodicity solve work in the scaled state
+//! `(q, q̇/ω_s)`, `ω_s` the highest natural frequency's estimate, so that the solve's pivots
+//! (and the rounding estimate made from them) do not depend on the time unit.
+//!
+//! **What it refuses.** A law that is not linear with piecewise-constant coefficients, more
+//! than [`PiecewiseExact::MAX_DOFS`] DOFs, and a model with a rigid-body mode (one that floats
+//! free): its `Z_p(0)` is singular and its periodic solution is not unique (harmonic balance
+//! handles such models, [`crate::model::RigidModes`]). [`PiecewiseExact::check`] tells in
+//! advance.
 //!
 //! ```
 //! use hbal::catalog::TwoShaft;
@@ -74,14 +84,17 @@ pub struct ExactSolution {
     /// The harmonics `0..=H` of the basis.
     pub solution: Solution,
     /// `relative`: the content of the harmonics `H+1..=L` (what the basis lacks), relative to
-    /// the harmonics `0..=L`, where `L` (`reference_harmonics`) is `2H` or, where the work is
-    /// affordable, up to four times the highest natural frequency (estimated from the diagonal
-    /// of `M⁻¹K`), where the jumps ring; `kept_harmonics`: the rounding of the periodicity
-    /// solve (machine precision times the condition of its pivots); both at least 1e-15.
+    /// the harmonics `0..=L`, where `L` (`reference_harmonics`) is at least `2H` and, as far
+    /// as the work budget allows, four times the highest natural frequency (estimated from the
+    /// diagonal of `M⁻¹K`), where the jumps ring; where the budget stops `L` short of that,
+    /// `lower_bound` is set (the content beyond `L` is not counted). `kept_harmonics`: a rough
+    /// rounding estimate of the periodicity solve, machine precision times the ratio of the
+    /// largest to the smallest pivot of `I - Φ` in the scaled state (not a bound; the harmonics
+    /// themselves are exact). Both at least 1e-15.
     pub estimate: ErrorEstimate,
-    /// The Floquet multipliers, the eigenvalues of the monodromy matrix `Φ` in `(q, q̇)`, by
-    /// decreasing modulus: exact to rounding (a linear scene's stability does not depend on the
-    /// orbit). All inside the unit circle: the orbit is stable.
+    /// The Floquet multipliers, the eigenvalues of the monodromy matrix `Φ`, by decreasing
+    /// modulus: exact to rounding (a linear scene's stability does not depend on the orbit).
+    /// The orbit is stable if all lie inside the unit circle.
     pub multipliers: Vec<Complex64>,
 }
 
@@ -114,24 +127,41 @@ impl PiecewiseExact {
     }
 
     /// The exact solution's harmonics `0..=H` in `basis`, and its estimate from the harmonics
-    /// `H+1..=2H`. An error names the element that is not linear with piecewise-constant
-    /// coefficients, a model above [`PiecewiseExact::MAX_DOFS`], or the piece and harmonic
-    /// where `Z_p` is singular (an undamped resonance, a free rigid-body mode).
+    /// `H+1..=L` ([`ExactSolution::estimate`]). An error names the element that is not linear
+    /// with piecewise-constant coefficients, a model above [`PiecewiseExact::MAX_DOFS`] or
+    /// with a rigid-body mode, or the harmonic where a piece's `Z_p` is singular (an undamped
+    /// resonance at a load's or a harmonic's frequency).
     pub fn solve_exact(&self, model: &Model, basis: &HarmonicBasis) -> Result<ExactSolution> {
         let start = Instant::now();
-        let schedule = Schedule::new(model, basis.omega())?;
-        let n = schedule.n;
         let nu = basis.subharmonic();
         let h = basis.harmonics();
+        // A singular Z_p is reported at the basis's harmonic (order l of Ω is harmonic l ν).
+        let in_basis = |e: Error| match e {
+            Error::SingularDynamicStiffness {
+                harmonic,
+                omega,
+                relative_pivot,
+                hint,
+            } => Error::SingularDynamicStiffness {
+                harmonic: harmonic * nu,
+                omega,
+                relative_pivot,
+                hint,
+            },
+            e => e,
+        };
+        let schedule = Schedule::new(model, basis.omega()).map_err(in_basis)?;
+        let n = schedule.n;
         // Orders of Ω computed: those the basis holds (harmonic j is order j/ν), and for the
         // estimate of what it lacks at least twice as many, up to four times the highest
         // natural frequency (where a jump's ringing lives) as far as the work budget allows.
         let ringing = (4.0 * schedule.highest_frequency() / basis.omega()).ceil();
         let per_order = schedule.configurations.len() * n * n * n + schedule.pieces.len() * n * n;
         let affordable = (ESTIMATE_WORK / per_order.max(1) as f64).floor();
-        let orders = ((2 * h) as f64).max(ringing.min(affordable)) as usize / nu;
-        let periodic = schedule.periodic_state()?;
-        let exact = schedule.harmonics(&periodic, orders)?;
+        let orders = ((2 * h).div_ceil(nu) as f64).max(ringing.min(affordable)) as usize;
+        let lower_bound = (orders as f64) < ringing;
+        let periodic = schedule.periodic_state().map_err(in_basis)?;
+        let exact = schedule.harmonics(&periodic, orders).map_err(in_basis)?;
         let mut harmonics = vec![Complex64::new(0.0, 0.0); (h + 1) * n];
         let mut kept = 0.0;
         let mut all = 0.0;
@@ -160,6 +190,7 @@ impl PiecewiseExact {
             relative: missing.max(rounding),
             kept_harmonics: rounding,
             reference_harmonics: orders * nu,
+            lower_bound,
         };
         let solution = Solution {
             basis: *basis,
@@ -196,31 +227,39 @@ struct Periodic {
     free_end: Vec<DVector<f64>>,
     /// `|x(T) - x(0)| / |x(0)|` after propagating the solved `x(0)` once more.
     closure: f64,
-    /// Largest over smallest pivot of the LU of `I - Φ`.
+    /// Largest over smallest pivot of the LU of `I - Φ` (scaled state).
     condition: f64,
-    /// The eigenvalues of `Φ`, by decreasing modulus.
+    /// The eigenvalues of `Φ` (those of the scaled and the unscaled `Φ` are one), by
+    /// decreasing modulus.
     multipliers: Vec<Complex64>,
 }
 
 impl Schedule {
-    /// Solves `(I - Φ) x(0) = c` and propagates the periodic state through the pieces.
+    /// Solves `(I - Φ) x(0) = c` in the scaled state `(q, q̇/ω_s)` and propagates the periodic
+    /// state through the pieces.
     fn periodic_state(&self) -> Result<Periodic> {
         let m = 2 * self.n;
         let mut phi = DMatrix::<f64>::identity(m, m);
         let mut c = DVector::<f64>::zeros(m);
         let mut work = ExpWork::new(m);
         let mut transitions = Vec::with_capacity(self.pieces.len());
+        let steady = |piece: &schedule::Piece, at_end: bool| {
+            let config = &self.configurations[piece.configuration];
+            let theta = if at_end { piece.end } else { piece.start };
+            self.scale_state(config.steady_state(theta, self.omega))
+        };
         for piece in &self.pieces {
             let config = &self.configurations[piece.configuration];
             let mut t = DMatrix::zeros(m, m);
             work.exp(&config.generator, piece.duration(self.omega), &mut t);
-            // The generator is in the scaled state (q, q̇/ω_s); back to (q, q̇).
-            let t = self.unscale_transition(&t);
-            let start = config.steady_state(piece.start, self.omega);
-            let end = config.steady_state(piece.end, self.omega);
-            c = &t * (c - start) + end;
+            c = &t * (c - steady(piece, false)) + steady(piece, true);
             phi = &t * phi;
             transitions.push(t);
+        }
+        if !(phi.iter().all(|v| v.is_finite()) && c.iter().all(|v| v.is_finite())) {
+            return Err(Error::NonFinite {
+                what: "the monodromy matrix of the exact piecewise solution".into(),
+            });
         }
         let mut multipliers: Vec<Complex64> = phi.complex_eigenvalues().iter().copied().collect();
         multipliers.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
@@ -231,7 +270,7 @@ impl Schedule {
         let (lo, hi) = pivots.fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
             (lo.min(p), hi.max(p))
         });
-        if !regular || lo == 0.0 {
+        if !regular || lo <= f64::EPSILON * hi {
             return Err(Error::Solver {
                 reason: "piecewise_exact: the monodromy matrix has a multiplier 1 (I - Φ is singular): an undamped or rigid-body motion without a unique periodic solution".into(),
             });
@@ -242,12 +281,11 @@ impl Schedule {
         let mut free_start = Vec::with_capacity(self.pieces.len());
         let mut free_end = Vec::with_capacity(self.pieces.len());
         for (piece, t) in self.pieces.iter().zip(&transitions) {
-            let config = &self.configurations[piece.configuration];
-            let h = &x - config.steady_state(piece.start, self.omega);
+            let h = &x - steady(piece, false);
             let e = t * &h;
-            x = config.steady_state(piece.end, self.omega) + &e;
-            free_start.push(h);
-            free_end.push(e);
+            x = steady(piece, true) + &e;
+            free_start.push(self.unscale_state(h));
+            free_end.push(self.unscale_state(e));
         }
         let closure = (&x - &x0).norm() / x0.norm().max(f64::MIN_POSITIVE);
         Ok(Periodic {
@@ -266,6 +304,7 @@ impl Schedule {
         let mut out = vec![Complex64::new(0.0, 0.0); (orders + 1) * n];
         let mut lu = ComplexLu::new(n);
         let mut rhs = vec![Complex64::new(0.0, 0.0); n];
+        let mut r = vec![Complex64::new(0.0, 0.0); 2 * n];
         let scale = self.omega / TAU;
         let loads = self.model_load_orders;
         let mut edges: Vec<EdgePhasors> = self
@@ -295,13 +334,15 @@ impl Schedule {
                     // e^{-sτ} = e^{-il(b - a)}.
                     let decay = edge.eb * edge.ea.conj();
                     let (h, e) = (&periodic.free_start[p], &periodic.free_end[p]);
-                    let r = |i: usize| decay * e[i] - h[i];
+                    for (ri, (ei, hi)) in r.iter_mut().zip(e.iter().zip(h.iter())) {
+                        *ri = decay * ei - hi;
+                    }
+                    let (rq, rv) = r.split_at(n);
                     for (i, b) in rhs.iter_mut().enumerate() {
                         let mut acc = Complex64::new(0.0, 0.0);
                         for j in 0..n {
-                            let rq = r(j);
-                            let rv = r(n + j);
-                            acc += self.mass[(i, j)] * (rv + s * rq) + config.damping[(i, j)] * rq;
+                            acc += self.mass[(i, j)] * (rv[j] + s * rq[j])
+                                + config.damping[(i, j)] * rq[j];
                         }
                         *b = -acc;
                     }

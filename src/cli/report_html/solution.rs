@@ -56,7 +56,12 @@ pub(super) fn solve_section(r: &mut HtmlReport, i: &Inputs) {
             "error estimate",
             match estimate["relative"].as_f64() {
                 Some(e) => format!(
-                    "{}, of harmonics 0..{} {} (against H = {}){}",
+                    "{}{}, of harmonics 0..{} {} (against H = {}){}",
+                    if estimate["lower_bound"].as_bool() == Some(true) {
+                        "at least "
+                    } else {
+                        ""
+                    },
                     significant(e, 2),
                     doc["harmonics"],
                     estimate["kept_harmonics"]

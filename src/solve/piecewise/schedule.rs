@@ -60,8 +60,7 @@ impl Schedule {
     /// at every element's time breakpoint and builds each distinct configuration.
     pub(super) fn new(model: &Model, omega: f64) -> Result<Self> {
         let n = model.n_dofs();
-        check(model)?;
-        let dense = model.dense("piecewise_exact")?;
+        let dense = checked(model)?;
         let mut breaks: Vec<f64> = model
             .elements()
             .iter()
@@ -215,22 +214,29 @@ impl Schedule {
         self.velocity_scale
     }
 
-    /// The transition `x(t) = T x(0)` in `(q, q̇)` from `T_s` in the scaled state.
-    pub(super) fn unscale_transition(&self, scaled: &DMatrix<f64>) -> DMatrix<f64> {
-        let n = self.n;
-        let ws = self.velocity_scale;
-        DMatrix::from_fn(2 * n, 2 * n, |i, j| {
-            let row = if i < n { 1.0 } else { ws };
-            let column = if j < n { 1.0 } else { 1.0 / ws };
-            scaled[(i, j)] * row * column
-        })
+    /// `(q, q̇) -> (q, q̇/ω_s)`.
+    pub(super) fn scale_state(&self, mut x: DVector<f64>) -> DVector<f64> {
+        x.rows_mut(self.n, self.n).unscale_mut(self.velocity_scale);
+        x
+    }
+
+    /// `(q, q̇/ω_s) -> (q, q̇)`.
+    pub(super) fn unscale_state(&self, mut x: DVector<f64>) -> DVector<f64> {
+        x.rows_mut(self.n, self.n).scale_mut(self.velocity_scale);
+        x
     }
 }
 
 /// Whether [`PiecewiseExact`] can solve `model`: at most [`PiecewiseExact::MAX_DOFS`] DOFs,
 /// no law with memory, every law linear time-invariant or piecewise constant
-/// ([`ForceLaw::is_piecewise_constant`](crate::force::ForceLaw::is_piecewise_constant)).
+/// ([`ForceLaw::is_piecewise_constant`](crate::force::ForceLaw::is_piecewise_constant)), no
+/// rigid-body mode (a free-free model has no unique periodic solution here).
 pub(super) fn check(model: &Model) -> Result<()> {
+    checked(model).map(|_| ())
+}
+
+/// [`check`], returning the dense matrices it builds.
+fn checked(model: &Model) -> Result<crate::model::DenseMatrices> {
     let n = model.n_dofs();
     if n > PiecewiseExact::MAX_DOFS {
         return Err(Error::TooLarge {
@@ -257,7 +263,18 @@ pub(super) fn check(model: &Model) -> Result<()> {
             });
         }
     }
-    Ok(())
+    let dense = model.dense("piecewise_exact")?;
+    if let Some(rigid) = crate::model::rigid::find_dense(model, &dense) {
+        return Err(Error::InvalidElement {
+            context: "method `piecewise_exact`".into(),
+            reason: format!(
+                "the model floats free ({} rigid-body mode{}, nothing grounds it), so its periodic solution is not unique and Z(0) is singular; use harmonic balance (newton, anderson), which separates the rigid-body motion",
+                rigid.len(),
+                if rigid.len() == 1 { "" } else { "s" }
+            ),
+        });
+    }
+    Ok(dense)
 }
 
 /// Factors `Z(s) = K + sD + s²M` into `lu`; an error names the harmonic where it is singular.

@@ -6,6 +6,12 @@ use crate::force::{LinearSpring, MeshDamping, MeshProfile, MeshStiffness, Offset
 /// with `preload`, both elements have offsets (their forces at rest `-k u0` are static loads,
 /// the mesh's jumping with its stiffness).
 fn chain(contact_ratio: f64, preload: bool) -> Model {
+    chain_in_time_unit(contact_ratio, preload, 1.0)
+}
+
+/// [`chain`] with time measured in units `c` times smaller: `M c²`, `D c` (the same motion at
+/// `Ω / c`).
+fn chain_in_time_unit(contact_ratio: f64, preload: bool, c: f64) -> Model {
     let mesh = MeshStiffness::new(
         3,
         MeshProfile::Rectangular {
@@ -13,13 +19,13 @@ fn chain(contact_ratio: f64, preload: bool) -> Model {
             two_tooth: 3.5e5,
             contact_ratio,
         },
-        MeshDamping::Proportional(4e-6),
+        MeshDamping::Proportional(4e-6 * c),
     );
-    let ground = LinearSpring::new(1e5, 0.5);
+    let ground = LinearSpring::new(1e5, 0.5 * c);
     let builder = Model::builder(&["a", "b"])
-        .mass_diagonal(&[1e-3, 2e-3])
+        .mass_diagonal(&[1e-3 * c * c, 2e-3 * c * c])
         .stiffness_triplets(&[(0, 0, 4e5)])
-        .damping_triplets(&[(0, 0, 2.0), (1, 1, 1.0)]);
+        .damping_triplets(&[(0, 0, 2.0 * c), (1, 1, 1.0 * c)]);
     let builder = if preload {
         builder
             .element("mesh", &[("a", 1.0), ("b", -0.5)], Offset::new(-2e-5, mesh))
@@ -175,4 +181,265 @@ fn preloaded_elements_against_the_time_domain() {
     let moved = crate::compare::relative_error(without.solution.harmonics(), &td.harmonics, 2, 16);
     eprintln!("preloaded: {err:.2e} against the time domain ({moved:.2e} without the preloads)");
     assert!(err < 1e-9 && moved > 1e-2, "{err:.2e}, {moved:.2e}");
+}
+
+#[test]
+fn the_solution_and_its_estimate_do_not_depend_on_the_time_unit() {
+    // The same motion in seconds, milliseconds and kiloseconds: the periodicity solve works in
+    // (q, q̇/ω_s), so its pivots, and the rounding estimate made from them, are one (in
+    // (q, q̇) they moved with the unit squared).
+    let omega = 3e5;
+    let solve = |c: f64| {
+        PiecewiseExact::new()
+            .solve_exact(
+                &chain_in_time_unit(1.6, true, c),
+                &HarmonicBasis::new(omega / c, 16).unwrap(),
+            )
+            .unwrap()
+    };
+    let seconds = solve(1.0);
+    for c in [1e-3, 1e3] {
+        let other = solve(c);
+        let err = crate::compare::relative_error(
+            other.solution.harmonics(),
+            seconds.solution.harmonics(),
+            2,
+            16,
+        );
+        let (a, b) = (
+            other.estimate.kept_harmonics,
+            seconds.estimate.kept_harmonics,
+        );
+        eprintln!("unit x{c}: {err:.1e} apart, kept {a:.2e} against {b:.2e}");
+        assert!(err < 1e-11, "x{c}: {err:.2e}");
+        assert!(
+            a <= 1.5 * b && b <= 1.5 * a,
+            "x{c}: {a:.2e} against {b:.2e}"
+        );
+        let (a, b) = (other.estimate.relative, seconds.estimate.relative);
+        assert!((a - b).abs() <= 1e-6 * b, "x{c}: {a:.3e} against {b:.3e}");
+        assert_eq!(
+            other.estimate.reference_harmonics,
+            seconds.estimate.reference_harmonics
+        );
+    }
+}
+
+#[test]
+fn a_model_that_floats_free_is_refused_by_its_rigid_body_mode() {
+    // Two inertias joined only by a mesh, the mean torques balanced: the mean angle is free.
+    let mesh = MeshStiffness::new(
+        2,
+        MeshProfile::Rectangular {
+            one_tooth: 2e5,
+            two_tooth: 3.5e5,
+            contact_ratio: 1.4,
+        },
+        MeshDamping::Proportional(4e-6),
+    );
+    let model = Model::builder(&["a", "b"])
+        .mass_diagonal(&[1e-3, 2e-3])
+        .element("mesh", &[("a", 1.0), ("b", -1.0)], mesh.clone())
+        .load("a", 0, 5.0, 0.0)
+        .load("b", 0, -5.0, 0.0)
+        .load("a", 1, 0.5, 0.0)
+        .build()
+        .unwrap();
+    let err = PiecewiseExact::check(&model).unwrap_err().to_string();
+    assert!(
+        err.contains("floats free") && err.contains("1 rigid-body mode"),
+        "{err}"
+    );
+    let basis = HarmonicBasis::new(3000.0, 8).unwrap();
+    let solved = PiecewiseExact::new().solve_exact(&model, &basis);
+    assert!(solved.unwrap_err().to_string().contains("floats free"));
+    // Grounded by a spring it is solved.
+    let grounded = Model::builder(&["a", "b"])
+        .mass_diagonal(&[1e-3, 2e-3])
+        .element("mesh", &[("a", 1.0), ("b", -1.0)], mesh)
+        .element("ground", &[("a", 1.0)], LinearSpring::new(1e3, 0.0))
+        .load("a", 0, 5.0, 0.0)
+        .build()
+        .unwrap();
+    assert!(PiecewiseExact::check(&grounded).is_ok());
+}
+
+#[test]
+fn a_period_multiple_holds_the_same_orders() {
+    // With ν = 2 harmonic j is order j/2: the even harmonics are the ν = 1 solution's, the odd
+    // ones (half orders a linear scene does not excite) are zero.
+    let model = chain(1.6, false);
+    let omega = 3000.0;
+    let one = PiecewiseExact::new()
+        .solve_exact(&model, &HarmonicBasis::new(omega, 8).unwrap())
+        .unwrap();
+    let basis = HarmonicBasis::new(omega, 16)
+        .unwrap()
+        .with_subharmonic(2)
+        .unwrap();
+    let two = PiecewiseExact::new().solve_exact(&model, &basis).unwrap();
+    let (a, b) = (one.solution.harmonics(), two.solution.harmonics());
+    for j in 0..=16 {
+        for i in 0..2 {
+            let got = b[j * 2 + i];
+            let want = if j % 2 == 0 {
+                a[(j / 2) * 2 + i]
+            } else {
+                Complex64::new(0.0, 0.0)
+            };
+            assert!(
+                (got - want).norm() <= 1e-13 * a[i].norm(),
+                "harmonic {j}, dof {i}: {got} against {want}"
+            );
+        }
+    }
+    assert_eq!(two.estimate.reference_harmonics % 2, 0);
+    // A singular Z is named at the basis's harmonic: order 1 is harmonic 2.
+    let undamped = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .stiffness_triplets(&[(0, 0, 4.0)])
+        .load("x", 1, 1.0, 0.0)
+        .build()
+        .unwrap();
+    let basis = HarmonicBasis::new(2.0, 8)
+        .unwrap()
+        .with_subharmonic(2)
+        .unwrap();
+    let err = PiecewiseExact::new()
+        .solve_exact(&undamped, &basis)
+        .unwrap_err();
+    assert!(
+        matches!(err, Error::SingularDynamicStiffness { harmonic: 2, .. }),
+        "{err}"
+    );
+}
+
+#[test]
+fn an_undamped_scene_off_resonance_is_its_frequency_response() {
+    // No damping: the multipliers lie on the unit circle (not at 1), I - Φ is regular and the
+    // harmonics are Z(kΩ)⁻¹ F_k.
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[2.0])
+        .stiffness_triplets(&[(0, 0, 50.0)])
+        .load("x", 1, 1.0, 0.0)
+        .load("x", 3, 0.5, 0.25)
+        .build()
+        .unwrap();
+    let omega = 1.7;
+    let exact = PiecewiseExact::new()
+        .solve_exact(&model, &HarmonicBasis::new(omega, 4).unwrap())
+        .unwrap();
+    let got = exact.solution.harmonics();
+    let want1 = 1.0 / (50.0 - 2.0 * omega * omega);
+    let want3 = Complex64::new(0.5, -0.25) / (50.0 - 2.0 * 9.0 * omega * omega);
+    assert!((got[1].re - want1).abs() < 1e-12 * want1.abs() && got[1].im.abs() < 1e-15);
+    assert!((got[3] - want3).norm() < 1e-12 * want3.norm(), "{}", got[3]);
+    for mu in &exact.multipliers {
+        assert!((mu.norm() - 1.0).abs() < 1e-12, "{mu}");
+    }
+}
+
+#[test]
+fn two_meshes_with_their_own_teeth_and_phases_against_the_time_domain() {
+    // Breakpoints of two meshes (3 and 5 cycles per period, phases 0.7 and 1.9 rad)
+    // interleave into 16 pieces of 4 configurations.
+    let mesh = |teeth, phase| {
+        MeshStiffness::new(
+            teeth,
+            MeshProfile::Rectangular {
+                one_tooth: 2e5,
+                two_tooth: 3.5e5,
+                contact_ratio: 1.45,
+            },
+            MeshDamping::Proportional(4e-6),
+        )
+        .with_phase(phase)
+    };
+    let model = Model::builder(&["a", "b", "c"])
+        .mass_diagonal(&[1e-3, 2e-3, 1.5e-3])
+        .stiffness_triplets(&[(0, 0, 4e5)])
+        .damping_triplets(&[(0, 0, 2.0), (2, 2, 1.0)])
+        .element("first", &[("a", 1.0), ("b", -0.5)], mesh(3, 0.7))
+        .element("second", &[("b", 1.0), ("c", -0.8)], mesh(5, 1.9))
+        .element("ground", &[("c", 1.0)], LinearSpring::new(1e5, 0.5))
+        .load("a", 0, 5.0, 0.0)
+        .load("c", 1, 0.7, -0.2)
+        .build()
+        .unwrap();
+    let omega = 1500.0;
+    let schedule = Schedule::new(&model, omega).unwrap();
+    assert_eq!(
+        (schedule.pieces.len(), schedule.configurations.len()),
+        (16, 4)
+    );
+    let exact = PiecewiseExact::new()
+        .solve_exact(&model, &HarmonicBasis::new(omega, 16).unwrap())
+        .unwrap();
+    let td = crate::timesim::TimeSimulation {
+        rtol: 1e-12,
+        steady_tolerance: 1e-11,
+        samples: 16384,
+        ..crate::timesim::TimeSimulation::default()
+    }
+    .run(&model, omega)
+    .unwrap();
+    let err = crate::compare::relative_error(exact.solution.harmonics(), &td.harmonics, 3, 16);
+    eprintln!("two meshes: {err:.2e} against the time domain");
+    assert!(err < 1e-9, "{err:.2e}");
+}
+
+#[test]
+fn an_estimate_cut_short_by_the_work_budget_says_it_is_a_lower_bound() {
+    // 30 DOFs at 10 rad/s: the jumps ring up to order ~11000, the budget affords a few hundred
+    // orders; the estimate counts what it computed and says that more may be missing.
+    let n = 30;
+    let names: Vec<String> = (0..n).map(|i| format!("d{i}")).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut k = vec![(0, 0, 4e5)];
+    let mut d = vec![];
+    for i in 1..n {
+        k.extend([
+            (i - 1, i - 1, 4e5),
+            (i, i, 4e5),
+            (i - 1, i, -4e5),
+            (i, i - 1, -4e5),
+        ]);
+        d.push((i, i, 0.5));
+    }
+    let model = Model::builder(&names)
+        .mass_diagonal(&vec![1e-3; n])
+        .stiffness_triplets(&k)
+        .damping_triplets(&d)
+        .element(
+            "mesh",
+            &[("d0", 1.0)],
+            MeshStiffness::new(
+                1,
+                MeshProfile::Rectangular {
+                    one_tooth: 2e5,
+                    two_tooth: 3.5e5,
+                    contact_ratio: 1.5,
+                },
+                MeshDamping::Proportional(4e-6),
+            ),
+        )
+        .load(names[n - 1], 0, 5.0, 0.0)
+        .build()
+        .unwrap();
+    let basis = HarmonicBasis::new(10.0, 8).unwrap();
+    let exact = PiecewiseExact::new().solve_exact(&model, &basis).unwrap();
+    let e = exact.estimate;
+    assert!(e.lower_bound, "{e:?}");
+    assert!(
+        e.reference_harmonics >= 16 && e.reference_harmonics < 2000,
+        "{e:?}"
+    );
+    assert!(e.relative > 1e-4 && e.relative.is_finite(), "{e:?}");
+    // The chain at 6000 rad/s: the ringing is within reach, the estimate is whole.
+    let basis = HarmonicBasis::new(6000.0, 8).unwrap();
+    let e = PiecewiseExact::new()
+        .solve_exact(&model, &basis)
+        .unwrap()
+        .estimate;
+    assert!(!e.lower_bound, "{e:?}");
 }
