@@ -54,6 +54,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     }
     let started = Instant::now();
     let solve_seconds;
+    let mut exact = None;
     let (sol, estimate, auto) = match scene.auto {
         Some(auto) => {
             if start.is_some() {
@@ -79,11 +80,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                     file.display()
                 );
             }
-            let exact = hbal::solve::PiecewiseExact::new()
+            let e = hbal::solve::PiecewiseExact::new()
                 .solve_exact(&scene.model, &scene.basis)
                 .map_err(|e| super::failure(e, &scene.file))?;
             solve_seconds = started.elapsed().as_secs_f64();
-            (exact.solution, Some(Ok(exact.estimate)), None)
+            let out = (e.solution.clone(), Some(Ok(e.estimate)), None);
+            exact = Some(e);
+            out
         }
         None => {
             let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
@@ -103,6 +106,17 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         }
     };
     hint_exact(&scene, estimate.as_ref());
+    // The exact method: its closed form in time (automatic harmonics kept the harmonics).
+    if exact.is_none() {
+        if let hbal::solve::Method::PiecewiseExact(method) = &scene.method {
+            exact = Some(
+                method
+                    .solve_exact(&scene.model, sol.basis())
+                    .map_err(|e| super::failure(e, &scene.file))?,
+            );
+        }
+    }
+    let extremes = exact.as_ref().map(|e| e.extremes());
     // Stability of a converged orbit (an unconverged iterate is no orbit to judge).
     let started = Instant::now();
     // Laws with memory: no multipliers rather than wrong ones (not a failure of the solve).
@@ -114,13 +128,43 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     });
     let stability: Option<Result<Floquet, String>> =
         (opts.stability && sol.is_converged() && unavailable.is_none()).then(|| {
-            sol.stability(&scene.model)
+            let floquet = match &exact {
+                // A linear scene's multipliers: those of the exact monodromy matrix.
+                Some(e) => Ok(Floquet {
+                    multipliers: e.multipliers.clone(),
+                    neutral: 0,
+                    orbit_correction: 0.0,
+                    polished: true,
+                    orbit_start: Vec::new(),
+                    steps: 0,
+                    reduction: None,
+                }),
+                None => sol.stability(&scene.model),
+            };
+            floquet
                 .map_err(|e| e.to_string())
                 .and_then(|f| super::check_finite(&f).map(|_| f))
         });
     let stability_seconds = started.elapsed().as_secs_f64();
-    let max_abs = sol.max_abs_all();
-    let elements = hbal::report::element_outputs(&scene.model, &sol).map_err(|e| e.to_string());
+    // Extremes of the exact method from its closed form, else from the harmonics.
+    let max_abs = match &extremes {
+        Some(x) => x
+            .dofs
+            .iter()
+            .map(|(lo, hi)| lo.abs().max(hi.abs()))
+            .collect(),
+        None => sol.max_abs_all(),
+    };
+    let elements = hbal::report::element_outputs(&scene.model, &sol)
+        .map(|outputs| match &extremes {
+            Some(x) => outputs
+                .into_iter()
+                .zip(&x.elements)
+                .map(|(o, e)| o.with_exact(e))
+                .collect(),
+            None => outputs,
+        })
+        .map_err(|e| e.to_string());
     let subharmonic = sol.basis().subharmonic();
     let order = |k| element_report::order_of(k, scene.fundamental_order, subharmonic);
     let dofs: Vec<_> = sol
@@ -175,6 +219,11 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 "reached": !capped,
                 "levels": levels,
             })),
+            // Where max_abs and the elements' extremes come from.
+            "extremes_from": match &extremes {
+                Some(x) => json!({"closed_form": {"intervals": x.intervals}}),
+                None => json!("harmonics"),
+            },
             "fundamental_rad_s": sol.basis().omega(),
             "harmonics": sol.basis().harmonics(),
             "samples": sol.basis().samples(),
@@ -232,6 +281,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 steps.join(", ")
             );
         }
+        if let Some(x) = &extremes {
+            say!(
+                "  extremes from the closed form in time ({} intervals), not from the harmonics 0..{}",
+                x.intervals,
+                sol.basis().harmonics()
+            );
+        }
         for (i, name) in sol.dof_names().iter().enumerate() {
             say!("  max |q| {name}: {:.6e}", max_abs[i]);
         }
@@ -247,6 +303,14 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 say!("  stability: not computed (the solve did not converge)")
             }
             None => {}
+            Some(Ok(f)) if exact.is_some() => say!(
+                "  stability: {}, max |μ| = {} ({} multiplier{} of the exact monodromy matrix), {:.1} ms",
+                if f.is_stable() { "stable" } else { "unstable" },
+                super::modulus(f.max_abs()),
+                f.multipliers.len(),
+                if f.multipliers.len() == 1 { "" } else { "s" },
+                stability_seconds * 1e3
+            ),
             Some(Ok(f)) => say!(
                 "  stability: {}, max |μ| = {} ({} multiplier{}, {} neutral), orbit correction {:.1e}{}, {:.1} ms",
                 if f.is_stable() { "stable" } else { "unstable" },
@@ -362,7 +426,7 @@ fn hint_exact(
         && hbal::solve::PiecewiseExact::check(&scene.model).is_ok()
     {
         eprintln!(
-            "note: {}: the harmonics 0..H are estimated {:.1e} off; this scene is linear with piecewise-constant coefficients: `--method piecewise_exact` gives them exactly",
+            "note: {}: the harmonics 0..H are estimated {:.1e} off; this scene is linear with piecewise-constant coefficients: `--method piecewise_exact` gives them, and the extremes in time, exactly",
             scene.file, e.kept_harmonics
         );
     }

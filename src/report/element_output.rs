@@ -64,6 +64,28 @@ pub struct MeshOutput {
     pub dynamic_factor: f64,
 }
 
+impl MeshOutput {
+    /// From the mesh's coordinate (transmission error, m or rad) and force.
+    fn new(te_unit: &'static str, coordinate: &Signal, force: &Signal) -> Self {
+        let scale = 1e6;
+        let mean = force.mean();
+        MeshOutput {
+            te_unit,
+            te_mean: coordinate.mean() * scale,
+            te_peak_to_peak: coordinate.peak_to_peak() * scale,
+            force_mean: mean,
+            force_max: force.max,
+            dynamic_force: (force.max - mean).max(mean - force.min),
+            // Loaded on either flank: the largest |f| over the mean |f̄|.
+            dynamic_factor: if mean != 0.0 {
+                force.max.abs().max(force.min.abs()) / mean.abs()
+            } else {
+                0.0
+            },
+        }
+    }
+}
+
 /// The outputs of one element.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ElementOutput {
@@ -81,6 +103,23 @@ pub struct ElementOutput {
     pub states: Vec<(String, f64)>,
     /// For a gear stage: transmission error and mesh force.
     pub mesh: Option<MeshOutput>,
+}
+
+impl ElementOutput {
+    /// The same outputs with the extremes and mean force of the exact periodic solution
+    /// ([`ExactSolution::extremes`](crate::solve::piecewise::ExactSolution::extremes)), which
+    /// the harmonics `0..=H` only approximate; the mesh outputs follow.
+    pub fn with_exact(mut self, exact: &crate::solve::piecewise::ElementExtremes) -> Self {
+        (self.coordinate.min, self.coordinate.max) = exact.coordinate;
+        (self.force.min, self.force.max) = exact.force;
+        if let Some(mean) = self.force.harmonics.first_mut() {
+            *mean = num_complex::Complex64::new(exact.force_mean, 0.0);
+        }
+        if let Some(mesh) = &self.mesh {
+            self.mesh = Some(MeshOutput::new(mesh.te_unit, &self.coordinate, &self.force));
+        }
+        self
+    }
 }
 
 /// The outputs of every element of `model` on the periodic solution `sol`.
@@ -201,26 +240,12 @@ pub(super) fn outputs_with_tail(
             max: fmax,
         };
         let mesh = e.gear_stage().map(|stage| {
-            let (unit, scale) = if stage.base_radii.is_some() {
-                ("µm", 1e6)
+            let unit = if stage.base_radii.is_some() {
+                "µm"
             } else {
-                ("µrad", 1e6)
+                "µrad"
             };
-            let mean = force.mean();
-            MeshOutput {
-                te_unit: unit,
-                te_mean: coordinate.mean() * scale,
-                te_peak_to_peak: coordinate.peak_to_peak() * scale,
-                force_mean: mean,
-                force_max: force.max,
-                dynamic_force: (force.max - mean).max(mean - force.min),
-                // Loaded on either flank: the largest |f| over the mean |f̄|.
-                dynamic_factor: if mean != 0.0 {
-                    force.max.abs().max(force.min.abs()) / mean.abs()
-                } else {
-                    0.0
-                },
-            }
+            MeshOutput::new(unit, &coordinate, &force)
         });
         out.push(ElementOutput {
             name: e.name().to_string(),

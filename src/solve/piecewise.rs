@@ -67,10 +67,13 @@ use std::time::Instant;
 mod factor;
 mod phasors;
 mod schedule;
+mod waveform;
 
 use factor::ComplexLu;
 use phasors::EdgePhasors;
 use schedule::Schedule;
+use waveform::Waveform;
+pub use waveform::{ElementExtremes, ExactExtremes, Range};
 
 /// The exact solver for linear scenes with piecewise-constant coefficients
 /// ([module docs](self)); scene files name it `method = "piecewise_exact"`.
@@ -96,6 +99,33 @@ pub struct ExactSolution {
     /// modulus: exact to rounding (a linear scene's stability does not depend on the orbit).
     /// The orbit is stable if all lie inside the unit circle.
     pub multipliers: Vec<Complex64>,
+    /// The closed form, for [`ExactSolution::extremes`].
+    waveform: std::sync::Arc<Waveform>,
+}
+
+impl ExactSolution {
+    /// The extremes of every DOF, element coordinate and element force over the exact
+    /// periodic solution, and the elements' mean forces, from the closed form in time (not
+    /// from the harmonics `0..=H`, which lack the ringing above H): see
+    /// [`ExactExtremes`](waveform) for the method.
+    ///
+    /// ```
+    /// use hbal::catalog::TwoShaft;
+    /// use hbal::solve::PiecewiseExact;
+    /// use hbal::HarmonicBasis;
+    /// let shaft = TwoShaft::new(60.0);
+    /// let exact = PiecewiseExact::new()
+    ///     .solve_exact(&shaft.model()?, &HarmonicBasis::new(shaft.mesh_omega(), 32)?)?;
+    /// let x = exact.extremes();
+    /// // The mesh carries the mean load L0 = 10 N m exactly.
+    /// assert!((x.elements[0].force_mean - 10.0).abs() < 1e-9);
+    /// // The largest deflection lies above the one-tooth static deflection 10/2.5e5.
+    /// assert!(x.dofs[0].1 > 10.0 / 2.5e5);
+    /// # Ok::<(), hbal::Error>(())
+    /// ```
+    pub fn extremes(&self) -> ExactExtremes {
+        self.waveform.extremes()
+    }
 }
 
 impl PiecewiseExact {
@@ -206,11 +236,25 @@ impl PiecewiseExact {
             },
             wall_time: start.elapsed(),
         };
-        let multipliers = periodic.multipliers.clone();
+        let Periodic {
+            free_start,
+            multipliers,
+            ..
+        } = periodic;
+        let waveform = Waveform {
+            schedule,
+            free_start,
+            weights: model
+                .elements()
+                .iter()
+                .map(|e| e.weights().to_vec())
+                .collect(),
+        };
         Ok(ExactSolution {
             solution,
             estimate,
             multipliers,
+            waveform: std::sync::Arc::new(waveform),
         })
     }
 }

@@ -110,6 +110,18 @@ fn hbal_solve_and_compare_with_the_exact_method() {
         estimate["reference_harmonics"].as_u64().unwrap() > 771,
         "{estimate}"
     );
+    // Extremes from the closed form: max |q| 5.7589e-5 (the time domain's samples reach
+    // 5.7588e-5; the harmonics 0..32 alone say 4.18e-5), the mesh carries L0 = 10 N m.
+    assert!(
+        json["extremes_from"]["closed_form"]["intervals"]
+            .as_u64()
+            .unwrap()
+            > 10_000
+    );
+    let max = json["dofs"][0]["max_abs"].as_f64().unwrap();
+    assert!((max - 5.7589e-5).abs() < 1e-9, "{max:e}");
+    let mean = json["elements"][0]["force"]["mean"].as_f64().unwrap();
+    assert!((mean - 10.0).abs() < 1e-9, "{}", json["elements"]);
     // --start is not used by the exact method, and says so.
     let start = std::env::temp_dir().join(format!("hbal-exact-start-{}.json", std::process::id()));
     std::fs::write(&start, &out).unwrap();
@@ -307,5 +319,44 @@ fn floquet_multipliers_of_the_exact_monodromy_matrix() {
             d <= 1e-10 * scale.max(1e-3),
             "{rpm} rpm: {d:.2e} of {scale:.2e}"
         );
+    }
+}
+
+/// The extremes of the closed form against the time domain's samples (65536 a period, about
+/// 85 per ringing period at 60 rpm): where the ringing of every jump lies above H = 32, the
+/// harmonics' own extremes are far off (max |q| 27 % low at 60 rpm).
+#[test]
+fn exact_extremes_against_the_time_domain_where_the_harmonics_lack_the_ringing() {
+    for rpm in [60.0, 600.0] {
+        let shaft = TwoShaft::new(rpm);
+        let model = shaft.model().unwrap();
+        let basis = HarmonicBasis::new(shaft.mesh_omega(), 32).unwrap();
+        let exact = PiecewiseExact::new().solve_exact(&model, &basis).unwrap();
+        let x = exact.extremes();
+        let td = TimeSimulation {
+            rtol: 1e-12,
+            steady_tolerance: 1e-11,
+            samples: 65536,
+            ..TimeSimulation::default()
+        }
+        .run(&model, shaft.mesh_omega())
+        .unwrap();
+        let q = &td.samples[0];
+        let (lo, hi) = q
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let series = exact.solution.max_abs_all()[0];
+        let (xlo, xhi) = x.dofs[0];
+        eprintln!(
+            "{rpm} rpm: exact [{xlo:.6e}, {xhi:.6e}], time domain [{lo:.6e}, {hi:.6e}], H = 32 series max {series:.6e}"
+        );
+        // Samples lie inside the exact range, and reach it to the sampling's resolution.
+        assert!(hi <= xhi * (1.0 + 1e-9) && lo >= xlo * (1.0 - 1e-9));
+        assert!((xhi - hi) < 5e-4 * xhi && (lo - xlo) < 5e-3 * xlo, "{rpm}");
+        assert!(series < 0.9 * xhi, "{rpm}: {series:e}");
+        let mean = x.elements[0].force_mean;
+        assert!((mean - TwoShaft::L0).abs() < 1e-9 * TwoShaft::L0, "{mean}");
     }
 }

@@ -35,6 +35,11 @@ pub(super) struct Configuration {
     pub(super) generator: Powers,
     /// The steady state under the loads, `Q_k` for orders `k = 0..=K` (one-sided, `Q[k n + i]`).
     steady: Vec<Complex64>,
+    /// `M⁻¹K`, `M⁻¹D`: the free motion's accelerations.
+    pub(super) mass_stiffness: DMatrix<f64>,
+    pub(super) mass_damping: DMatrix<f64>,
+    /// Every element's `(k_e, d_e, f_e)` on this configuration (force `k_e u + d_e u̇ + f_e`).
+    pub(super) elements: Vec<(f64, f64, f64)>,
     n: usize,
 }
 
@@ -147,8 +152,8 @@ impl Schedule {
             1.0
         };
         for (coefficients, k, d) in systems {
-            let rest: Vec<f64> = coefficients.iter().map(|c| c.2).collect();
-            let config = schedule.configuration(model, &inverse, &rest, k, d)?;
+            let mut config = schedule.configuration(model, &inverse, &coefficients, k, d)?;
+            config.elements = coefficients;
             schedule.configurations.push(config);
         }
         Ok(schedule)
@@ -160,7 +165,7 @@ impl Schedule {
         &self,
         model: &Model,
         mass_inverse: &DMatrix<f64>,
-        rest: &[f64],
+        coefficients: &[(f64, f64, f64)],
         k: DMatrix<f64>,
         d: DMatrix<f64>,
     ) -> Result<Configuration> {
@@ -186,7 +191,7 @@ impl Schedule {
                 block[load.dof] += Complex64::new(load.cos, -sin);
             }
             if order == 0 {
-                for (e, &f) in model.elements().iter().zip(rest) {
+                for (e, &(_, _, f)) in model.elements().iter().zip(coefficients) {
                     for &(i, w) in e.weights() {
                         block[i] -= w * f;
                     }
@@ -204,6 +209,9 @@ impl Schedule {
             damping: d,
             generator: Powers::new(a),
             steady,
+            mass_stiffness: mk,
+            mass_damping: md,
+            elements: Vec::new(),
             n,
         })
     }
@@ -314,6 +322,25 @@ impl Configuration {
             }
         }
         x
+    }
+
+    /// The steady state and its first three time derivatives at angle `θ`:
+    /// `Re Σ_k (ikΩ)^m Q_k e^{ikθ}`, `m = 0..=3`.
+    pub(super) fn steady_jet(&self, theta: f64, omega: f64) -> [DVector<f64>; 4] {
+        let n = self.n;
+        let mut jet = [0; 4].map(|_| DVector::zeros(n));
+        for (order, block) in self.steady.chunks(n).enumerate() {
+            let e = Complex64::from_polar(1.0, order as f64 * theta);
+            let rate = Complex64::new(0.0, order as f64 * omega);
+            let mut factor = e;
+            for d in jet.iter_mut() {
+                for (i, q) in block.iter().enumerate() {
+                    d[i] += (factor * q).re;
+                }
+                factor *= rate;
+            }
+        }
+        jet
     }
 
     /// Adds the two-sided coefficient `c_l` of the steady state on a piece (zero elsewhere)
