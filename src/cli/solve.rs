@@ -2,6 +2,7 @@
 //! `--start` file, compute the orbit's Floquet stability, print a summary or one JSON object, and
 //! optionally write harmonics.csv, time_series.csv and SVG plots.
 
+use super::solve_exact;
 use super::solve_files::{write_outputs, OutputLabel};
 use super::{element_report, load, multipliers_json, start, Failure, SolverArgs};
 use anyhow::Context;
@@ -105,16 +106,10 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             (sol, estimate, None)
         }
     };
-    hint_exact(&scene, estimate.as_ref());
+    solve_exact::hint(&scene, estimate.as_ref());
     // The exact method: its closed form in time (automatic harmonics kept the harmonics).
     if exact.is_none() {
-        if let hbal::solve::Method::PiecewiseExact(method) = &scene.method {
-            exact = Some(
-                method
-                    .solve_exact(&scene.model, sol.basis())
-                    .map_err(|e| super::failure(e, &scene.file))?,
-            );
-        }
+        exact = solve_exact::again(&scene, &sol)?;
     }
     let extremes = exact.as_ref().map(|e| e.extremes());
     // Stability of a converged orbit (an unconverged iterate is no orbit to judge).
@@ -129,16 +124,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let stability: Option<Result<Floquet, String>> =
         (opts.stability && sol.is_converged() && unavailable.is_none()).then(|| {
             let floquet = match &exact {
-                // A linear scene's multipliers: those of the exact monodromy matrix.
-                Some(e) => Ok(Floquet {
-                    multipliers: e.multipliers.clone(),
-                    neutral: 0,
-                    orbit_correction: 0.0,
-                    polished: true,
-                    orbit_start: Vec::new(),
-                    steps: 0,
-                    reduction: None,
-                }),
+                Some(e) => Ok(solve_exact::floquet(e)),
                 None => sol.stability(&scene.model),
             };
             floquet
@@ -156,14 +142,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         None => sol.max_abs_all(),
     };
     let elements = hbal::report::element_outputs(&scene.model, &sol)
-        .map(|outputs| match &extremes {
-            Some(x) => outputs
-                .into_iter()
-                .zip(&x.elements)
-                .map(|(o, e)| o.with_exact(e))
-                .collect(),
-            None => outputs,
-        })
+        .map(|outputs| solve_exact::element_outputs(outputs, extremes.as_ref()))
         .map_err(|e| e.to_string());
     let subharmonic = sol.basis().subharmonic();
     let order = |k| element_report::order_of(k, scene.fundamental_order, subharmonic);
@@ -411,23 +390,4 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     } else {
         1
     })
-}
-
-/// A note where harmonic balance leaves the harmonics 0..H of a scene with an error above 1e-6
-/// that the exact piecewise solution would solve exactly (linear, piecewise-constant
-/// coefficients: a rectangular mesh stiffness at low speed).
-fn hint_exact(
-    scene: &hbal::scene::Scene,
-    estimate: Option<&Result<hbal::solve::ErrorEstimate, String>>,
-) {
-    let Some(Ok(e)) = estimate else { return };
-    if e.kept_harmonics > 1e-6
-        && !matches!(scene.method, hbal::solve::Method::PiecewiseExact(_))
-        && hbal::solve::PiecewiseExact::check(&scene.model).is_ok()
-    {
-        eprintln!(
-            "note: {}: the harmonics 0..H are estimated {:.1e} off; this scene is linear with piecewise-constant coefficients: `--method piecewise_exact` gives them, and the extremes in time, exactly",
-            scene.file, e.kept_harmonics
-        );
-    }
 }

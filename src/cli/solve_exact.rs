@@ -1,0 +1,72 @@
+//! What `hbal solve` does differently for the exact piecewise solution: its multipliers are
+//! those of the exact monodromy matrix, its extremes those of the closed form in time; and the
+//! note that points harmonic balance's users to it.
+
+use super::Failure;
+use hbal::report::ElementOutput;
+use hbal::solution::Solution;
+use hbal::solve::piecewise::{ExactExtremes, ExactSolution};
+use hbal::stability::Floquet;
+
+/// The stability of a linear scene: the eigenvalues of its exact monodromy matrix (no
+/// shooting, no orbit to correct).
+pub(crate) fn floquet(exact: &ExactSolution) -> Floquet {
+    Floquet {
+        multipliers: exact.multipliers.clone(),
+        neutral: 0,
+        orbit_correction: 0.0,
+        polished: true,
+        orbit_start: Vec::new(),
+        steps: 0,
+        reduction: None,
+    }
+}
+
+/// The element outputs with the exact extremes and mean forces where there are some.
+pub(crate) fn element_outputs(
+    outputs: Vec<ElementOutput>,
+    extremes: Option<&ExactExtremes>,
+) -> Vec<ElementOutput> {
+    match extremes {
+        Some(x) => outputs
+            .into_iter()
+            .zip(&x.elements)
+            .map(|(o, e)| o.with_exact(e))
+            .collect(),
+        None => outputs,
+    }
+}
+
+/// The exact solution on the basis automatic harmonics chose, for its closed form; `None` for
+/// other methods.
+pub(crate) fn again(
+    scene: &hbal::scene::Scene,
+    sol: &Solution,
+) -> Result<Option<ExactSolution>, Failure> {
+    match &scene.method {
+        hbal::solve::Method::PiecewiseExact(method) => method
+            .solve_exact(&scene.model, sol.basis())
+            .map(Some)
+            .map_err(|e| super::failure(e, &scene.file)),
+        _ => Ok(None),
+    }
+}
+
+/// A note where harmonic balance leaves the harmonics 0..H of a scene with an error above 1e-6
+/// that the exact piecewise solution would solve exactly (linear, piecewise-constant
+/// coefficients: a rectangular mesh stiffness at low speed).
+pub(crate) fn hint(
+    scene: &hbal::scene::Scene,
+    estimate: Option<&Result<hbal::solve::ErrorEstimate, String>>,
+) {
+    let Some(Ok(e)) = estimate else { return };
+    if e.kept_harmonics > 1e-6
+        && !matches!(scene.method, hbal::solve::Method::PiecewiseExact(_))
+        && hbal::solve::PiecewiseExact::check(&scene.model).is_ok()
+    {
+        eprintln!(
+            "note: {}: the harmonics 0..H are estimated {:.1e} off; this scene is linear with piecewise-constant coefficients: `--method piecewise_exact` gives them, and the extremes in time, exactly",
+            scene.file, e.kept_harmonics
+        );
+    }
+}
