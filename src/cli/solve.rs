@@ -356,7 +356,8 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             ),
             prefix,
         };
-        let mut written = write_outputs(dir, &sol, &label, order)
+        let series = exact.as_ref().and_then(solve_exact::time_series);
+        let mut written = write_outputs(dir, &sol, &label, order, series)
             .with_context(|| format!("--out: cannot write {}", dir.display()))?;
         if let Ok(e) = &elements {
             element_report::write_csv(&dir.join(format!("{prefix}elements.csv")), e, order)

@@ -13,11 +13,15 @@ pub(crate) struct OutputLabel {
     pub(crate) prefix: &'static str,
 }
 
+/// Writes harmonics.csv, time_series.csv and the plots of `sol` into `dir`; the time series
+/// is `series` (`[dof][sample]` over one period) where given (the exact method's closed
+/// form), else synthesised from the harmonics.
 pub(crate) fn write_outputs(
     dir: &Path,
     sol: &Solution,
     label: &OutputLabel,
     order: impl Fn(usize) -> f64,
+    series: Option<Vec<Vec<f64>>>,
 ) -> anyhow::Result<Vec<String>> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let file = |name: &str| dir.join(format!("{}{name}", label.prefix));
@@ -39,11 +43,14 @@ pub(crate) fn write_outputs(
     }
     w.flush()?;
     let mut written = vec![format!("{}harmonics.csv", label.prefix)];
-    let points = sol.basis().samples().max(256);
     let period = sol.basis().period();
-    let series: Vec<Vec<f64>> = (0..sol.dof_names().len())
-        .map(|i| sol.time_series(i, points))
-        .collect();
+    let series: Vec<Vec<f64>> = series.unwrap_or_else(|| {
+        let points = sol.basis().samples().max(256);
+        (0..sol.dof_names().len())
+            .map(|i| sol.time_series(i, points))
+            .collect()
+    });
+    let points = series.first().map_or(0, Vec::len);
     let mut w = csv::Writer::from_path(file("time_series.csv"))?;
     let mut header = vec!["t".to_string(), "theta".to_string()];
     header.extend(sol.dof_names().iter().cloned());

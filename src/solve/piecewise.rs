@@ -129,6 +129,19 @@ impl ExactSolution {
     pub fn extremes(&self) -> ExactExtremes {
         self.waveform.extremes()
     }
+
+    /// The exact `q_i(θ_j)` at `θ_j = 2π j / points` (`[i][j]`), from the closed form.
+    pub fn time_series(&self, points: usize) -> Vec<Vec<f64>> {
+        self.waveform.time_series(points)
+    }
+
+    /// Samples a period needs to show the fastest natural motion (16 per period of the
+    /// highest natural frequency's estimate), at least 256 and at most 65536.
+    pub fn resolving_points(&self) -> usize {
+        let s = &self.waveform.schedule;
+        let per = (16.0 * s.highest_frequency() / s.omega).ceil();
+        (per.min(65536.0) as usize).max(256)
+    }
 }
 
 impl PiecewiseExact {

@@ -360,3 +360,31 @@ fn exact_extremes_against_the_time_domain_where_the_harmonics_lack_the_ringing()
         assert!((mean - TwoShaft::L0).abs() < 1e-9 * TwoShaft::L0, "{mean}");
     }
 }
+
+#[test]
+fn the_exact_methods_files_show_the_ringing() {
+    // --out at 60 rpm: time_series.csv from the closed form, 16 samples per period of the
+    // highest natural frequency (771 of them per mesh period), its largest value the exact
+    // extreme to the sampling; the harmonics 0..32 would top out at 4.18e-5.
+    let dir = std::env::temp_dir().join(format!("hbal-exact-out-{}", std::process::id()));
+    let (code, _, err) = run(&[
+        "solve",
+        &scene("two_shaft_60rpm.toml"),
+        "--method",
+        "piecewise_exact",
+        "--no-stability",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let text = std::fs::read_to_string(dir.join("time_series.csv")).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let q: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
+        .collect();
+    assert!(q.len() > 12_000, "{}", q.len());
+    let max = q.iter().fold(0.0f64, |m, &v| m.max(v));
+    assert!(max > 5.7e-5 && max <= 5.7589e-5, "{max:e}");
+}
