@@ -283,11 +283,16 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             }
             None => {}
             Some(Ok(f)) if exact.is_some() => say!(
-                "  stability: {}, max |μ| = {} ({} multiplier{} of the exact monodromy matrix), {:.1} ms",
+                "  stability: {}, max |μ| = {} ({} multiplier{} of the exact monodromy matrix{}), {:.1} ms",
                 if f.is_stable() { "stable" } else { "unstable" },
                 super::modulus(f.max_abs()),
                 f.multipliers.len(),
                 if f.multipliers.len() == 1 { "" } else { "s" },
+                if f.neutral > 0 {
+                    format!(", {} neutral of the rigid body", f.neutral)
+                } else {
+                    String::new()
+                },
                 stability_seconds * 1e3
             ),
             Some(Ok(f)) => say!(

@@ -13,7 +13,7 @@ use hbal::stability::Floquet;
 pub(crate) fn floquet(exact: &ExactSolution) -> Floquet {
     Floquet {
         multipliers: exact.multipliers.clone(),
-        neutral: 0,
+        neutral: exact.neutral,
         orbit_correction: 0.0,
         polished: true,
         orbit_start: Vec::new(),

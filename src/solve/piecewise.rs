@@ -38,11 +38,13 @@
 //! `(q, q̇/ω_s)`, `ω_s` the highest natural frequency's estimate, so that the solve's pivots
 //! (and the rounding estimate made from them) do not depend on the time unit.
 //!
+//! **Free bodies.** A model that floats free (rigid-body modes, [`crate::model::RigidModes`])
+//! has its rigid motion separated exactly and the rest shifted to a regular system
+//! ([`free_body`]): the mean rigid position is zero, as with harmonic balance.
+//!
 //! **What it refuses.** A law that is not linear with piecewise-constant coefficients, more
-//! than [`PiecewiseExact::MAX_DOFS`] DOFs, and a model with a rigid-body mode (one that floats
-//! free): its `Z_p(0)` is singular and its periodic solution is not unique (harmonic balance
-//! handles such models, [`crate::model::RigidModes`]). [`PiecewiseExact::check`] tells in
-//! advance.
+//! than [`PiecewiseExact::MAX_DOFS`] DOFs, and a model that floats free under mean loads that
+//! do not balance. [`PiecewiseExact::check`] tells in advance.
 //!
 //! ```
 //! use hbal::catalog::TwoShaft;
@@ -68,6 +70,7 @@ use num_complex::Complex64;
 use std::time::Instant;
 
 mod factor;
+pub mod free_body;
 mod periodic;
 mod phasors;
 mod schedule;
@@ -100,8 +103,11 @@ pub struct ExactSolution {
     pub estimate: ErrorEstimate,
     /// The Floquet multipliers, the eigenvalues of the monodromy matrix `Φ`, by decreasing
     /// modulus: exact to rounding (a linear scene's stability does not depend on the orbit).
-    /// The orbit is stable if all lie inside the unit circle.
+    /// The orbit is stable if all lie inside the unit circle. A model that floats free has
+    /// two more per rigid-body mode, exactly 1, counted in `neutral` and left out.
     pub multipliers: Vec<Complex64>,
+    /// Multipliers exactly 1 of the rigid-body motion (two per mode), left out.
+    pub neutral: usize,
     /// The closed form, for [`ExactSolution::extremes`].
     waveform: std::sync::Arc<Waveform>,
 }
@@ -174,9 +180,10 @@ impl PiecewiseExact {
 
     /// The exact solution's harmonics `0..=H` in `basis`, and its estimate from the harmonics
     /// `H+1..=L` ([`ExactSolution::estimate`]). An error names the element that is not linear
-    /// with piecewise-constant coefficients, a model above [`PiecewiseExact::MAX_DOFS`] or
-    /// with a rigid-body mode, or the harmonic where a piece's `Z_p` is singular (an undamped
-    /// resonance at a load's or a harmonic's frequency).
+    /// with piecewise-constant coefficients, a model above [`PiecewiseExact::MAX_DOFS`], a
+    /// model that floats free under mean loads that do not balance, or the harmonic where a
+    /// piece's `Z_p` is singular (an undamped resonance at a load's or a harmonic's
+    /// frequency).
     pub fn solve_exact(&self, model: &Model, basis: &HarmonicBasis) -> Result<ExactSolution> {
         let start = Instant::now();
         let nu = basis.subharmonic();
@@ -252,6 +259,7 @@ impl PiecewiseExact {
             },
             wall_time: start.elapsed(),
         };
+        let neutral = 2 * schedule.rigid_modes();
         let Periodic {
             free_start,
             multipliers,
@@ -270,6 +278,7 @@ impl PiecewiseExact {
             solution,
             estimate,
             multipliers,
+            neutral,
             waveform: std::sync::Arc::new(waveform),
         })
     }

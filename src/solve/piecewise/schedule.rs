@@ -1,6 +1,7 @@
 //! The pieces of a period between the coefficients' jumps, and the constant system on each.
 
 use super::factor::ComplexLu;
+use super::free_body::FreeBody;
 use super::phasors::EdgePhasors;
 use super::PiecewiseExact;
 use crate::error::{Error, Result};
@@ -58,6 +59,8 @@ pub(super) struct Schedule {
     pub(super) pieces: Vec<Piece>,
     /// The highest load order K.
     pub(super) model_load_orders: usize,
+    /// The rigid-body modes of a model that floats free, separated exactly.
+    free_body: Option<FreeBody>,
 }
 
 impl Schedule {
@@ -65,7 +68,7 @@ impl Schedule {
     /// at every element's time breakpoint and builds each distinct configuration.
     pub(super) fn new(model: &Model, omega: f64) -> Result<Self> {
         let n = model.n_dofs();
-        let dense = checked(model)?;
+        let (dense, free_body) = checked(model)?;
         let mut breaks: Vec<f64> = model
             .elements()
             .iter()
@@ -88,6 +91,7 @@ impl Schedule {
             configurations: Vec::new(),
             pieces: Vec::new(),
             model_load_orders: model.max_load_order(),
+            free_body,
         };
         let mut systems: Vec<System> = Vec::new();
         for (i, &start) in breaks.iter().enumerate() {
@@ -151,7 +155,13 @@ impl Schedule {
         } else {
             1.0
         };
-        for (coefficients, k, d) in systems {
+        if let Some(free) = schedule.free_body.as_mut() {
+            free.set_rate(schedule.velocity_scale, TAU / omega);
+        }
+        for (coefficients, mut k, mut d) in systems {
+            if let Some(free) = &schedule.free_body {
+                free.shift(&mut k, &mut d)?;
+            }
             let mut config = schedule.configuration(model, &inverse, &coefficients, k, d)?;
             config.elements = coefficients;
             schedule.configurations.push(config);
@@ -200,9 +210,16 @@ impl Schedule {
             if block.iter().all(|c| c.norm() == 0.0) {
                 continue;
             }
+            let rigid = self
+                .free_body
+                .as_ref()
+                .map(|free| free.split_load(block, order, self.omega));
             let s = Complex64::new(0.0, order as f64 * self.omega);
             factor_at(&mut lu, &self.mass, &k, &d, s, order, self.omega)?;
             lu.solve(block);
+            for (b, r) in block.iter_mut().zip(rigid.iter().flatten()) {
+                *b += r;
+            }
         }
         Ok(Configuration {
             stiffness: k,
@@ -222,6 +239,11 @@ impl Schedule {
         self.velocity_scale
     }
 
+    /// The number of rigid-body modes (0 for a grounded model).
+    pub(super) fn rigid_modes(&self) -> usize {
+        self.free_body.as_ref().map_or(0, FreeBody::count)
+    }
+
     /// `(q, q̇) -> (q, q̇/ω_s)`.
     pub(super) fn scale_state(&self, mut x: DVector<f64>) -> DVector<f64> {
         x.rows_mut(self.n, self.n).unscale_mut(self.velocity_scale);
@@ -237,14 +259,14 @@ impl Schedule {
 
 /// Whether [`PiecewiseExact`] can solve `model`: at most [`PiecewiseExact::MAX_DOFS`] DOFs,
 /// no law with memory, every law linear time-invariant or piecewise constant
-/// ([`ForceLaw::is_piecewise_constant`](crate::force::ForceLaw::is_piecewise_constant)), no
-/// rigid-body mode (a free-free model has no unique periodic solution here).
+/// ([`ForceLaw::is_piecewise_constant`](crate::force::ForceLaw::is_piecewise_constant)), mean
+/// loads that balance on a model that floats free.
 pub(super) fn check(model: &Model) -> Result<()> {
     checked(model).map(|_| ())
 }
 
-/// [`check`], returning the dense matrices it builds.
-fn checked(model: &Model) -> Result<crate::model::DenseMatrices> {
+/// [`check`], returning the dense matrices it builds and the rigid-body modes.
+fn checked(model: &Model) -> Result<(crate::model::DenseMatrices, Option<FreeBody>)> {
     let n = model.n_dofs();
     if n > PiecewiseExact::MAX_DOFS {
         return Err(Error::TooLarge {
@@ -272,17 +294,8 @@ fn checked(model: &Model) -> Result<crate::model::DenseMatrices> {
         }
     }
     let dense = model.dense("piecewise_exact")?;
-    if let Some(rigid) = crate::model::rigid::find_dense(model, &dense) {
-        return Err(Error::InvalidElement {
-            context: "method `piecewise_exact`".into(),
-            reason: format!(
-                "the model floats free ({} rigid-body mode{}, nothing grounds it), so its periodic solution is not unique and Z(0) is singular; use harmonic balance (newton, anderson), which separates the rigid-body motion",
-                rigid.len(),
-                if rigid.len() == 1 { "" } else { "s" }
-            ),
-        });
-    }
-    Ok(dense)
+    let free_body = FreeBody::find(model, &dense)?;
+    Ok((dense, free_body))
 }
 
 /// Factors `Z(s) = K + sD + s²M` into `lu`; an error names the harmonic where it is singular.

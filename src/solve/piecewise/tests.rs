@@ -184,42 +184,83 @@ fn preloaded_elements_against_the_time_domain() {
 }
 
 #[test]
-fn a_model_that_floats_free_is_refused_by_its_rigid_body_mode() {
-    // Two inertias joined only by a mesh, the mean torques balanced: the mean angle is free.
-    let mesh = MeshStiffness::new(
-        2,
+fn a_model_that_floats_free_has_its_rigid_motion_separated() {
+    // Two inertias joined only by a mesh, the mean torques balanced, an order-1 torque on one:
+    // the rigid body swings with it, the mesh twists.
+    let free = |profile: MeshProfile, mean_b: f64| {
+        Model::builder(&["a", "b"])
+            .mass_diagonal(&[1e-3, 2e-3])
+            .element(
+                "mesh",
+                &[("a", 1.0), ("b", -1.0)],
+                MeshStiffness::new(2, profile, MeshDamping::Proportional(4e-6)),
+            )
+            .load("a", 0, 5.0, 0.0)
+            .load("b", 0, mean_b, 0.0)
+            .load("a", 1, 0.5, 0.2)
+            .build()
+            .unwrap()
+    };
+    let omega = 3000.0;
+    let newton = |model: &Model, h: usize| {
+        let hb = HarmonicBalance::new(model, HarmonicBasis::new(omega, h).unwrap()).unwrap();
+        crate::Newton::new()
+            .with_tolerance(1e-12)
+            .unwrap()
+            .solve_from_option(&hb, None, &mut hb.workspace())
+            .unwrap()
+    };
+    // Constant stiffness: harmonic balance is exact, and so the same mean rigid position
+    // (zero) and rigid swing.
+    let constant = free(MeshProfile::Constant { stiffness: 3e5 }, -5.0);
+    let exact = PiecewiseExact::new()
+        .solve_exact(&constant, &HarmonicBasis::new(omega, 4).unwrap())
+        .unwrap();
+    let hb = newton(&constant, 4);
+    let err = crate::compare::relative_error(exact.solution.harmonics(), hb.harmonics(), 2, 4);
+    assert!(err < 1e-12, "{err:.2e}");
+    assert_eq!((exact.multipliers.len(), exact.neutral), (2, 2));
+    // Rectangular stiffness: harmonic balance at H = 64 approaches the exact harmonics.
+    let rectangular = free(
         MeshProfile::Rectangular {
             one_tooth: 2e5,
             two_tooth: 3.5e5,
             contact_ratio: 1.4,
         },
-        MeshDamping::Proportional(4e-6),
+        -5.0,
     );
-    let model = Model::builder(&["a", "b"])
-        .mass_diagonal(&[1e-3, 2e-3])
-        .element("mesh", &[("a", 1.0), ("b", -1.0)], mesh.clone())
-        .load("a", 0, 5.0, 0.0)
-        .load("b", 0, -5.0, 0.0)
-        .load("a", 1, 0.5, 0.0)
-        .build()
+    let exact = PiecewiseExact::new()
+        .solve_exact(&rectangular, &HarmonicBasis::new(omega, 8).unwrap())
         .unwrap();
-    let err = PiecewiseExact::check(&model).unwrap_err().to_string();
-    assert!(
-        err.contains("floats free") && err.contains("1 rigid-body mode"),
-        "{err}"
+    let err = crate::compare::relative_error(
+        exact.solution.harmonics(),
+        newton(&rectangular, 64).harmonics(),
+        2,
+        8,
     );
-    let basis = HarmonicBasis::new(3000.0, 8).unwrap();
-    let solved = PiecewiseExact::new().solve_exact(&model, &basis);
-    assert!(solved.unwrap_err().to_string().contains("floats free"));
-    // Grounded by a spring it is solved.
+    eprintln!("free-free, rectangular: HB at H = 64 {err:.2e} from the exact harmonics");
+    assert!(err < 1e-7, "{err:.2e}");
+    assert!(exact.multipliers[0].norm() < 1.0 && exact.neutral == 2);
+    // Mean loads that do not balance: the body accelerates away, named.
+    let err =
+        PiecewiseExact::check(&free(MeshProfile::Constant { stiffness: 3e5 }, -4.0)).unwrap_err();
+    assert!(matches!(err, Error::UnbalancedStaticLoad { .. }), "{err}");
+    // Grounded by a spring there is no rigid body.
     let grounded = Model::builder(&["a", "b"])
         .mass_diagonal(&[1e-3, 2e-3])
-        .element("mesh", &[("a", 1.0), ("b", -1.0)], mesh)
         .element("ground", &[("a", 1.0)], LinearSpring::new(1e3, 0.0))
+        .element(
+            "mesh",
+            &[("a", 1.0), ("b", -1.0)],
+            LinearSpring::new(3e5, 1.0),
+        )
         .load("a", 0, 5.0, 0.0)
         .build()
         .unwrap();
-    assert!(PiecewiseExact::check(&grounded).is_ok());
+    let exact = PiecewiseExact::new()
+        .solve_exact(&grounded, &HarmonicBasis::new(omega, 4).unwrap())
+        .unwrap();
+    assert_eq!((exact.multipliers.len(), exact.neutral), (4, 0));
 }
 
 #[test]
