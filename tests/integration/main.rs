@@ -48,6 +48,7 @@ mod new_laws;
 mod nlvib_03;
 mod order_cuts;
 mod piecewise_exact;
+mod piecewise_exact_cli;
 mod reference_solutions;
 mod report;
 mod scene_export;

@@ -72,7 +72,7 @@ fn low_speeds_and_jumps_between_samples_against_the_time_domain() {
 }
 
 /// `hbal` run on `args`, its exit code and its standard output and error.
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
+pub(super) fn run(args: &[&str]) -> (Option<i32>, String, String) {
     let out = crate::common::hbal(args);
     (
         out.status.code(),
@@ -81,7 +81,7 @@ fn run(args: &[&str]) -> (Option<i32>, String, String) {
     )
 }
 
-fn scene(name: &str) -> String {
+pub(super) fn scene(name: &str) -> String {
     format!("{}/examples/scenes/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
@@ -213,67 +213,6 @@ fn the_exact_method_refuses_what_it_cannot_solve() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A model that floats free: the rigid motion separated, the exact method in `hbal compare`
-/// agreeing with the time domain far below harmonic balance at H = 16; with mean loads that do
-/// not balance, refused by the net torque.
-#[test]
-fn a_model_that_floats_free() {
-    let dir = std::env::temp_dir().join(format!("hbal-exact-free-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let free = dir.join("free.toml");
-    std::fs::write(&free, FREE_FREE).unwrap();
-    let free = free.to_str().unwrap();
-    let (code, out, err) = run(&["solve", free, "--method", "piecewise_exact"]);
-    assert_eq!(code, Some(0), "{err}");
-    assert!(out.contains("2 neutral"), "{out}");
-    let (code, out, err) = run(&["compare", free, "--json"]);
-    assert_eq!(code, Some(0), "{err}");
-    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let error_of = |name: &str| {
-        json["methods"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|m| m["method"] == name)
-            .and_then(|m| m["error_vs_time_domain"].as_f64())
-            .unwrap_or_else(|| panic!("{name} missing: {out}"))
-    };
-    assert!(error_of("piecewise_exact") < 1e-7, "{out}");
-    assert!(error_of("newton") > 1e-5, "{out}");
-    let unbalanced = dir.join("unbalanced.toml");
-    std::fs::write(&unbalanced, FREE_FREE.replace("cos = -5.0", "cos = -4.0")).unwrap();
-    let (code, _, err) = run(&[
-        "solve",
-        unbalanced.to_str().unwrap(),
-        "--method",
-        "piecewise_exact",
-    ]);
-    let _ = std::fs::remove_dir_all(&dir);
-    assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("balance") || err.contains("net"), "{err}");
-}
-
-/// Two inertias joined only by a rectangular mesh, the mean torques balanced.
-const FREE_FREE: &str = r#"
-dofs = ["pinion", "gear"]
-mass = [[1e-3, 0], [0, 2e-3]]
-fundamental = { rad_s = 3000 }
-harmonics = { count = 16 }
-loads = [
-  { dof = "pinion", order = 0, cos = 5.0 },
-  { dof = "gear", order = 0, cos = -5.0 },
-  { dof = "pinion", order = 1, cos = 0.5 },
-]
-
-[[elements]]
-name = "mesh"
-type = "mesh_stiffness"
-connects = { pinion = 1.0, gear = -1.0 }
-teeth = 1
-profile = { shape = "rectangular", one_tooth = 2.5e5, two_tooth = 5e5, contact_ratio = 1.5 }
-damping = { proportional = 5e-6 }
-"#;
-
 #[test]
 fn automatic_harmonics_with_the_exact_method() {
     use hbal::solve::{solve_auto, AutoHarmonics, Control, Method};
@@ -379,32 +318,4 @@ fn exact_extremes_against_the_time_domain_where_the_harmonics_lack_the_ringing()
         let mean = x.elements[0].force_mean;
         assert!((mean - TwoShaft::L0).abs() < 1e-9 * TwoShaft::L0, "{mean}");
     }
-}
-
-#[test]
-fn the_exact_methods_files_show_the_ringing() {
-    // --out at 60 rpm: time_series.csv from the closed form, 16 samples per period of the
-    // highest natural frequency (771 of them per mesh period), its largest value the exact
-    // extreme to the sampling; the harmonics 0..32 would top out at 4.18e-5.
-    let dir = std::env::temp_dir().join(format!("hbal-exact-out-{}", std::process::id()));
-    let (code, _, err) = run(&[
-        "solve",
-        &scene("two_shaft_60rpm.toml"),
-        "--method",
-        "piecewise_exact",
-        "--no-stability",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    assert_eq!(code, Some(0), "{err}");
-    let text = std::fs::read_to_string(dir.join("time_series.csv")).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    let q: Vec<f64> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
-        .collect();
-    assert!(q.len() > 12_000, "{}", q.len());
-    let max = q.iter().fold(0.0f64, |m, &v| m.max(v));
-    assert!(max > 5.7e-5 && max <= 5.7589e-5, "{max:e}");
 }
