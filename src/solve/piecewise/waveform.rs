@@ -125,6 +125,17 @@ impl Tracker {
         self.min = self.min.min(v);
         self.max = self.max.max(v);
     }
+
+    /// Whether the quintic between `a` and `b` can leave the range seen so far: it lies
+    /// within `[min(g_0, g_1) - B, max(g_0, g_1) + B]`,
+    /// `B = 0.25 δ (|g'_0| + |g'_1|) + 0.03 δ² (|g''_0| + |g''_1|)` (the largest moduli of its
+    /// Hermite basis functions on [0, 1] are 0.2 and 0.02). Flat stretches, where `g'` changes
+    /// sign at rounding level, are skipped.
+    fn may_extend(&self, a: &[f64; 3], b: &[f64; 3], dt: f64) -> bool {
+        let bound =
+            0.25 * dt * (a[1].abs() + b[1].abs()) + 0.03 * dt * dt * (a[2].abs() + b[2].abs());
+        a[0].max(b[0]) + bound > self.max || a[0].min(b[0]) - bound < self.min
+    }
 }
 
 impl Waveform {
@@ -168,8 +179,10 @@ impl Waveform {
                 }
                 if let Some(before) = &last {
                     for (t, (a, b)) in track.iter_mut().zip(before.iter().zip(&jets)) {
-                        if let Some(v) = interior_extremum(a, b, dt) {
-                            t.see(v);
+                        if t.may_extend(a, b, dt) {
+                            if let Some(v) = interior_extremum(a, b, dt) {
+                                t.see(v);
+                            }
                         }
                     }
                     for (e, sum) in integral.iter_mut().enumerate() {
