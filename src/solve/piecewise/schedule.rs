@@ -244,6 +244,11 @@ impl Schedule {
         self.free_body.as_ref().map_or(0, FreeBody::count)
     }
 
+    /// `ω_s`, the velocity scale of the generators' state.
+    pub(super) fn velocity_scale(&self) -> f64 {
+        self.velocity_scale
+    }
+
     /// `(q, q̇) -> (q, q̇/ω_s)`.
     pub(super) fn scale_state(&self, mut x: DVector<f64>) -> DVector<f64> {
         x.rows_mut(self.n, self.n).unscale_mut(self.velocity_scale);
@@ -339,9 +344,11 @@ impl Configuration {
 
     /// The steady state and its first three time derivatives at angle `θ`:
     /// `Re Σ_k (ikΩ)^m Q_k e^{ikθ}`, `m = 0..=3`.
-    pub(super) fn steady_jet(&self, theta: f64, omega: f64) -> [DVector<f64>; 4] {
+    pub(super) fn steady_jet_into(&self, theta: f64, omega: f64, jet: &mut [DVector<f64>; 4]) {
         let n = self.n;
-        let mut jet = [0; 4].map(|_| DVector::zeros(n));
+        for d in jet.iter_mut() {
+            d.fill(0.0);
+        }
         for (order, block) in self.steady.chunks(n).enumerate() {
             let e = Complex64::from_polar(1.0, order as f64 * theta);
             let rate = Complex64::new(0.0, order as f64 * omega);
@@ -353,7 +360,6 @@ impl Configuration {
                 factor *= rate;
             }
         }
-        jet
     }
 
     /// Adds the two-sided coefficient `c_l` of the steady state on a piece (zero elsewhere)

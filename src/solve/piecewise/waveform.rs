@@ -160,6 +160,7 @@ impl Waveform {
         let rate = wanted.min(affordable);
         let mut work = ExpWork::new(2 * n);
         let mut step = DMatrix::zeros(2 * n, 2 * n);
+        let mut buffers = JetBuffers::new(n, m);
         let mut total = 0;
         for (piece, h) in s.pieces.iter().zip(&self.free_start) {
             let config = &s.configurations[piece.configuration];
@@ -169,16 +170,24 @@ impl Waveform {
             let dt = tau / intervals as f64;
             work.exp(&config.generator, dt, &mut step);
             let mut scaled = s.scale_state(h.clone());
-            let mut last: Option<Jets> = None;
+            let mut next = DVector::zeros(2 * n);
             for j in 0..=intervals {
                 let theta = piece.start + j as f64 * dt * omega;
-                let x = s.unscale_state(scaled.clone());
-                let jets = jets(config, &self.weights, theta, omega, &x);
-                for (t, jet) in track.iter_mut().zip(&jets) {
+                buffers.fill(
+                    config,
+                    &self.weights,
+                    theta,
+                    omega,
+                    &scaled,
+                    s.velocity_scale(),
+                );
+                let jets = &buffers.now;
+                for (t, jet) in track.iter_mut().zip(jets) {
                     t.see(jet[0]);
                 }
-                if let Some(before) = &last {
-                    for (t, (a, b)) in track.iter_mut().zip(before.iter().zip(&jets)) {
+                if j > 0 {
+                    let before = &buffers.before;
+                    for (t, (a, b)) in track.iter_mut().zip(before.iter().zip(jets)) {
                         if t.may_extend(a, b, dt) {
                             if let Some(v) = interior_extremum(a, b, dt) {
                                 t.see(v);
@@ -192,9 +201,10 @@ impl Waveform {
                             + dt * dt * dt / 120.0 * (a[2] + b[2]);
                     }
                 }
-                last = Some(jets);
+                std::mem::swap(&mut buffers.now, &mut buffers.before);
                 if j < intervals {
-                    scaled = &step * scaled;
+                    step.mul_to(&scaled, &mut next);
+                    std::mem::swap(&mut scaled, &mut next);
                 }
             }
         }
@@ -213,44 +223,72 @@ impl Waveform {
     }
 }
 
-/// `(g, g', g'')` of every DOF, element coordinate and element force at angle `θ` with the
-/// free motion `x = (q_f, q̇_f)` on `config`.
-fn jets(
-    config: &Configuration,
-    weights: &[Vec<(usize, f64)>],
-    theta: f64,
-    omega: f64,
-    x: &DVector<f64>,
-) -> Jets {
-    let n = x.len() / 2;
-    let [mut q, mut v, mut a, mut j] = config.steady_jet(theta, omega);
-    let (qf, vf) = (x.rows(0, n), x.rows(n, n));
-    let af = -(&config.mass_stiffness * qf + &config.mass_damping * vf);
-    let jf = -(&config.mass_stiffness * vf + &config.mass_damping * &af);
-    q += qf;
-    v += vf;
-    a += &af;
-    j += &jf;
-    let mut out: Jets = (0..n).map(|i| [q[i], v[i], a[i]]).collect();
-    let gather = |w: &[(usize, f64)], y: &DVector<f64>| w.iter().map(|&(i, c)| c * y[i]).sum();
-    let elements: Vec<[f64; 4]> = weights
-        .iter()
-        .map(|w| [gather(w, &q), gather(w, &v), gather(w, &a), gather(w, &j)])
-        .collect();
-    out.extend(elements.iter().map(|u| [u[0], u[1], u[2]]));
-    out.extend(
-        elements
-            .iter()
-            .zip(&config.elements)
-            .map(|(u, &(k, d, f0))| {
-                [
-                    k * u[0] + d * u[1] + f0,
-                    k * u[1] + d * u[2],
-                    k * u[2] + d * u[3],
-                ]
-            }),
-    );
-    out
+/// The jets of one interval's two ends and the vectors they are made from, reused.
+struct JetBuffers {
+    /// `q`, `q̇`, `q̈`, `q⃛` at the current angle.
+    derivatives: [DVector<f64>; 4],
+    /// `-M⁻¹(K q_f + D q̇_f)` and `-M⁻¹(K q̇_f + D q̈_f)` of the free motion.
+    free: [DVector<f64>; 2],
+    /// `(g, g', g'')` of every DOF, element coordinate and element force, at the interval's
+    /// end and at its start.
+    now: Jets,
+    before: Jets,
+}
+
+impl JetBuffers {
+    fn new(n: usize, m: usize) -> Self {
+        let zeros = || DVector::zeros(n);
+        Self {
+            derivatives: [zeros(), zeros(), zeros(), zeros()],
+            free: [zeros(), zeros()],
+            now: vec![[0.0; 3]; n + 2 * m],
+            before: vec![[0.0; 3]; n + 2 * m],
+        }
+    }
+
+    /// `now` at angle `θ` with the free motion `scaled = (q_f, q̇_f/ω_s)` on `config`.
+    fn fill(
+        &mut self,
+        config: &Configuration,
+        weights: &[Vec<(usize, f64)>],
+        theta: f64,
+        omega: f64,
+        scaled: &DVector<f64>,
+        velocity_scale: f64,
+    ) {
+        let n = scaled.len() / 2;
+        config.steady_jet_into(theta, omega, &mut self.derivatives);
+        let [q, v, a, j] = &mut self.derivatives;
+        let [af, jf] = &mut self.free;
+        let qf = scaled.rows(0, n);
+        let vf = scaled.rows(n, n) * velocity_scale;
+        config.mass_stiffness.mul_to(&qf, af);
+        af.gemv(1.0, &config.mass_damping, &vf, 1.0);
+        af.neg_mut();
+        config.mass_stiffness.mul_to(&vf, jf);
+        jf.gemv(1.0, &config.mass_damping, af, 1.0);
+        jf.neg_mut();
+        *q += qf;
+        *v += &vf;
+        *a += &*af;
+        *j += &*jf;
+        for (i, out) in self.now[..n].iter_mut().enumerate() {
+            *out = [q[i], v[i], a[i]];
+        }
+        let gather = |w: &[(usize, f64)], y: &DVector<f64>| -> f64 {
+            w.iter().map(|&(i, c)| c * y[i]).sum()
+        };
+        let m = weights.len();
+        for (e, (w, &(k, d, f0))) in weights.iter().zip(&config.elements).enumerate() {
+            let u = [gather(w, q), gather(w, v), gather(w, a), gather(w, j)];
+            self.now[n + e] = [u[0], u[1], u[2]];
+            self.now[n + m + e] = [
+                k * u[0] + d * u[1] + f0,
+                k * u[1] + d * u[2],
+                k * u[2] + d * u[3],
+            ];
+        }
+    }
 }
 
 /// The value at an interior extremum of the quintic Hermite interpolant between `a` and `b`
@@ -299,109 +337,4 @@ fn interior_extremum(a: &[f64; 3], b: &[f64; 3], dt: f64) -> Option<f64> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::catalog::TwoShaft;
-    use crate::force::LinearSpring;
-    use crate::solve::PiecewiseExact;
-    use crate::{HarmonicBasis, Model};
-
-    #[test]
-    fn the_quintic_finds_the_peak_of_a_cosine() {
-        // g = cos t around its maximum at 0.3: exact to O(δ⁶).
-        let g = |t: f64| [(t - 0.3).cos(), -(t - 0.3).sin(), -(t - 0.3).cos()];
-        let dt = TAU / 32.0;
-        let v = interior_extremum(&g(0.2), &g(0.2 + dt), dt).unwrap();
-        assert!((v - 1.0).abs() < 1e-8, "{v}");
-        assert!(interior_extremum(&g(0.4), &g(0.4 + dt), dt).is_none());
-    }
-
-    #[test]
-    fn the_extremes_of_the_closed_form() {
-        // An LTI scene: q = Q0 + |Q1| cos(...), its extremes Q0 ± |Q1| exactly; the spring's
-        // mean force is k Q0.
-        let model = Model::builder(&["x"])
-            .mass_diagonal(&[2.0])
-            .damping_triplets(&[(0, 0, 0.3)])
-            .element("spring", &[("x", 1.0)], LinearSpring::new(50.0, 0.1))
-            .load("x", 0, 1.0, 0.0)
-            .load("x", 1, 0.5, 0.25)
-            .build()
-            .unwrap();
-        let exact = PiecewiseExact::new()
-            .solve_exact(&model, &HarmonicBasis::new(1.7, 4).unwrap())
-            .unwrap();
-        let q = exact.solution.harmonics();
-        let x = exact.extremes();
-        let (lo, hi) = (q[0].re - q[1].norm(), q[0].re + q[1].norm());
-        assert!(
-            (x.dofs[0].0 - lo).abs() < 1e-12 && (x.dofs[0].1 - hi).abs() < 1e-12,
-            "{x:?}"
-        );
-        assert_eq!(x.elements[0].coordinate, x.dofs[0]);
-        assert!((x.elements[0].force_mean - 1.0).abs() < 1e-12, "{x:?}");
-        // The two-shaft model at 6000 rpm: against the extremes of its harmonics at H = 4096
-        // within 1e-8 of the range (3e-10 measured), and the mesh's mean force is the
-        // mean load.
-        let shaft = TwoShaft::new(6000.0);
-        let model = shaft.model().unwrap();
-        let basis = |h| HarmonicBasis::new(shaft.mesh_omega(), h).unwrap();
-        let x = PiecewiseExact::new()
-            .solve_exact(&model, &basis(32))
-            .unwrap()
-            .extremes();
-        let fine = PiecewiseExact::new()
-            .solve_exact(&model, &basis(4096))
-            .unwrap();
-        let (lo, hi) = fine.solution.extremes(0);
-        let scale = hi - lo;
-        eprintln!(
-            "6000 rpm: [{:e}, {:e}] against [{lo:e}, {hi:e}], mean force {}",
-            x.dofs[0].0, x.dofs[0].1, x.elements[0].force_mean
-        );
-        assert!((x.dofs[0].0 - lo).abs() < 1e-8 * scale);
-        assert!((x.dofs[0].1 - hi).abs() < 1e-8 * scale);
-        assert!((x.elements[0].force_mean - TwoShaft::L0).abs() < 1e-10 * TwoShaft::L0);
-    }
-
-    #[test]
-    fn the_time_series_is_the_time_domains() {
-        // The two-shaft model at 600 rpm, where the ringing of every jump lies above H = 32:
-        // sample by sample the time domain's final period at rtol 1e-13 (2.4e-9 apart; 9.8e-9
-        // at rtol 1e-12: the difference is the time domain's error).
-        let shaft = TwoShaft::new(600.0);
-        let model = shaft.model().unwrap();
-        let basis = HarmonicBasis::new(shaft.mesh_omega(), 32).unwrap();
-        let exact = PiecewiseExact::new().solve_exact(&model, &basis).unwrap();
-        let points = 2048;
-        let series = exact.time_series(points);
-        let td = crate::timesim::TimeSimulation {
-            rtol: 1e-13,
-            steady_tolerance: 1e-12,
-            samples: points,
-            ..crate::timesim::TimeSimulation::default()
-        }
-        .run(&model, shaft.mesh_omega())
-        .unwrap();
-        let scale = td.samples[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let worst = series[0]
-            .iter()
-            .zip(&td.samples[0])
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0f64, f64::max);
-        eprintln!(
-            "600 rpm: time series {:.1e} off the time domain",
-            worst / scale
-        );
-        assert!(worst < 1e-8 * scale, "{:.2e}", worst / scale);
-        // The harmonics 0..32 alone are far off between the samples of the ringing.
-        let truncated = exact.solution.time_series(0, points);
-        let off = truncated
-            .iter()
-            .zip(&td.samples[0])
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0f64, f64::max);
-        assert!(off > 0.1 * scale, "{:.2e}", off / scale);
-        assert!(exact.resolving_points() >= 256);
-    }
-}
+mod tests;
