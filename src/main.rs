@@ -110,7 +110,8 @@ enum Command {
         /// `loads[1].cos` (a warm-started sweep that does not follow folds).
         #[arg(long)]
         parameter: Option<String>,
-        /// Number of values of a --parameter sweep (2 to 100000).
+        /// Number of values of a --parameter sweep, or of speeds of a sweep with method
+        /// piecewise_exact (evenly spaced; a linear scene needs no continuation) (2 to 100000).
         #[arg(long, default_value_t = 101, value_parser = sweep_points(2))]
         points: usize,
     },
@@ -301,6 +302,7 @@ fn main() -> ExitCode {
                     stability: !no_stability,
                     max_points,
                     max_step,
+                    points,
                     json,
                     out: out.as_deref(),
                     all_branches,

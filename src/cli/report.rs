@@ -97,6 +97,7 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
                     stability: opts.stability,
                     max_points: None,
                     max_step: 0.5,
+                    points: 101,
                     json: true,
                     out: Some(&dir.join("sweep")),
                     all_branches: false,

@@ -124,7 +124,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let stability: Option<Result<Floquet, String>> =
         (opts.stability && sol.is_converged() && unavailable.is_none()).then(|| {
             let floquet = match &exact {
-                Some(e) => Ok(solve_exact::floquet(e)),
+                Some(e) => Ok(e.floquet()),
                 None => sol.stability(&scene.model),
             };
             floquet

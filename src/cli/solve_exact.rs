@@ -6,21 +6,6 @@ use super::Failure;
 use hbal::report::ElementOutput;
 use hbal::solution::Solution;
 use hbal::solve::piecewise::{ExactExtremes, ExactSolution};
-use hbal::stability::Floquet;
-
-/// The stability of a linear scene: the eigenvalues of its exact monodromy matrix (no
-/// shooting, no orbit to correct).
-pub(crate) fn floquet(exact: &ExactSolution) -> Floquet {
-    Floquet {
-        multipliers: exact.multipliers.clone(),
-        neutral: exact.neutral,
-        orbit_correction: 0.0,
-        polished: true,
-        orbit_start: Vec::new(),
-        steps: 0,
-        reduction: None,
-    }
-}
 
 /// The element outputs with the exact extremes and mean forces where there are some.
 pub(crate) fn element_outputs(

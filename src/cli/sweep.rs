@@ -21,6 +21,8 @@ pub(crate) struct SweepOptions<'a> {
     pub(crate) stability: bool,
     pub(crate) max_points: Option<usize>,
     pub(crate) max_step: f64,
+    /// Evenly spaced speeds of a sweep with the exact piecewise solution (no continuation).
+    pub(crate) points: usize,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
     /// Switch to the branches leaving the main one at its branch points and period doublings.
@@ -42,8 +44,23 @@ fn run(
     basis: HarmonicBasis,
     to: f64,
     initial: Option<&[Complex64]>,
+    points: usize,
     progress: impl FnMut(f64),
 ) -> hbal::Result<Branch> {
+    if matches!(continuation.method, hbal::solve::Method::PiecewiseExact(_)) {
+        // A linear scene has no turning points: the exact solution at `points` evenly spaced
+        // speeds, each with its own estimate, extremes and multipliers.
+        let from = basis.omega();
+        let values: Vec<f64> = (0..points)
+            .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
+            .collect();
+        return hbal::continuation::sweep_values(
+            &values,
+            |w| Ok((model, basis.with_omega(w)?)),
+            continuation,
+            progress,
+        );
+    }
     continuation.run_from(model, basis, to, initial, progress)
 }
 
@@ -62,6 +79,14 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     let unit = scene.speed_unit;
     let per = scene.omega_per_speed;
     let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
+    if matches!(scene.method, hbal::solve::Method::PiecewiseExact(_)) {
+        if let Some(file) = opts.start {
+            eprintln!(
+                "note: --start {} is not used: the exact piecewise solution needs no start",
+                file.display()
+            );
+        }
+    }
     // Default start speed: the start file's, else the scene's.
     let from = opts.from.unwrap_or_else(|| {
         start
@@ -155,6 +180,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         basis,
         to * per,
         start.as_ref().map(|s| s.harmonics.as_slice()),
+        opts.points,
         |f| bar.set_position((f * 1000.0) as u64),
     )
     .map_err(|e| super::sweep_failure(e, &scene.file))?;

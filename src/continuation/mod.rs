@@ -27,7 +27,7 @@ mod point;
 mod speed_homotopy;
 mod switch;
 
-pub use parameter::parameter_sweep;
+pub use parameter::{parameter_sweep, sweep_values};
 pub use speed_homotopy::solve_robustly;
 
 use crate::solve::{Method, Newton};

@@ -5,7 +5,7 @@ use super::{Branch, BranchStop, Continuation};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::residual::HarmonicBalance;
-use crate::solve::{robust_start, Newton};
+use crate::solve::{robust_start, Method, Newton};
 use crate::stability::FloquetOptions;
 use crate::{Formulation, HarmonicBasis};
 use num_complex::Complex64;
@@ -16,21 +16,35 @@ use num_complex::Complex64;
 /// as in [`HarmonicBalance::with_formulation`] (the points always hold every DOF).
 pub fn parameter_sweep(
     values: &[f64],
-    mut build: impl FnMut(f64) -> Result<(Model, HarmonicBasis)>,
+    build: impl FnMut(f64) -> Result<(Model, HarmonicBasis)>,
     stability: Option<FloquetOptions>,
     formulation: Formulation,
-    mut progress: impl FnMut(f64),
+    progress: impl FnMut(f64),
 ) -> Result<Branch> {
-    let mut branch: Option<Branch> = None;
-    let mut previous: Option<Vec<Complex64>> = None;
     let cont = Continuation {
         stability,
         formulation,
         ..Continuation::default()
     };
+    sweep_values(values, build, &cont, progress)
+}
+
+/// [`parameter_sweep`] with the settings of `cont` (its method, tolerance, stability,
+/// formulation): the method starts the first value, Newton from the previous point the
+/// others; with [`Method::PiecewiseExact`] every value is solved exactly (a linear scene's
+/// points are independent). A failure after the first value ends the branch with its points.
+pub fn sweep_values<M: std::borrow::Borrow<Model>>(
+    values: &[f64],
+    mut build: impl FnMut(f64) -> Result<(M, HarmonicBasis)>,
+    cont: &Continuation,
+    mut progress: impl FnMut(f64),
+) -> Result<Branch> {
+    let mut branch: Option<Branch> = None;
+    let mut previous: Option<Vec<Complex64>> = None;
+    let formulation = cont.formulation;
     for (i, &p) in values.iter().enumerate() {
         let (model, basis) = match build(p) {
-            Ok(v) => v,
+            Ok((m, b)) => (m, b),
             Err(e) => match branch.as_mut() {
                 // Keep the points so far.
                 Some(b) => {
@@ -43,7 +57,8 @@ pub fn parameter_sweep(
                 None => return Err(e),
             },
         };
-        let mut hb = match HarmonicBalance::with_formulation(&model, basis, formulation) {
+        let model: &Model = model.borrow();
+        let mut hb = match HarmonicBalance::with_formulation(model, basis, formulation) {
             Ok(hb) => hb,
             // After the first point, a numerical failure ends the branch and keeps its points.
             Err(e) => match branch.as_mut() {
@@ -60,8 +75,28 @@ pub fn parameter_sweep(
         crate::solve::check_dense_for_continuation(&hb)?;
         let mut ws = hb.workspace();
         let full = (basis.harmonics() + 1) * model.n_dofs();
-        let sol = match &previous {
-            Some(q) if q.len() == full => {
+        let mut exact = None;
+        let sol = match (&cont.method, &previous) {
+            (Method::PiecewiseExact(method), _) => match method.solve_exact(model, &basis) {
+                Ok(e) => {
+                    branch
+                        .get_or_insert_with(|| Branch::new(model, basis, "piecewise_exact".into()));
+                    let sol = e.solution.clone();
+                    exact = Some(e);
+                    sol
+                }
+                Err(e) => match branch.as_mut() {
+                    Some(b) => {
+                        b.stop = BranchStop::Failed {
+                            parameter: p,
+                            reason: e.to_string(),
+                        };
+                        break;
+                    }
+                    None => return Err(e),
+                },
+            },
+            (_, Some(q)) if q.len() == full => {
                 match Newton::new()
                     .with_tolerance(cont.tolerance)?
                     .solve_from(&hb, q, &mut ws)
@@ -82,12 +117,12 @@ pub fn parameter_sweep(
                 if let Some(b) = branch.as_mut() {
                     b.start = start.how;
                 } else {
-                    branch = Some(Branch::new(&model, basis, start.how));
+                    branch = Some(Branch::new(model, basis, start.how));
                 }
                 start.solution
             }
         };
-        let b = branch.get_or_insert_with(|| Branch::new(&model, basis, String::new()));
+        let b = branch.get_or_insert_with(|| Branch::new(model, basis, String::new()));
         if !sol.is_converged() {
             b.stop = if i == 0 {
                 BranchStop::StartFailed {
@@ -99,9 +134,25 @@ pub fn parameter_sweep(
             break;
         }
         previous = Some(sol.harmonics().to_vec());
-        let point = NewPoint::new(&model, basis, sol.harmonics().to_vec(), p, sol.residual());
+        let point = NewPoint::new(model, basis, sol.harmonics().to_vec(), p, sol.residual()).map(
+            |mut point| {
+                // The exact solution's own estimate, extremes and multipliers.
+                if let Some(e) = exact.take() {
+                    point.max_abs = Some(
+                        e.extremes()
+                            .dofs
+                            .iter()
+                            .map(|(lo, hi)| lo.abs().max(hi.abs()))
+                            .collect(),
+                    );
+                    point.estimate = Some(e.estimate);
+                    point.floquet = Some(e.floquet());
+                }
+                point
+            },
+        );
         let failed = match point {
-            Ok(point) => cont.push_point(b, &model, point),
+            Ok(point) => cont.push_point(b, model, point),
             Err(reason) => Some(reason),
         };
         if let Some(reason) = failed {

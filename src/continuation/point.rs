@@ -30,6 +30,10 @@ pub(super) struct NewPoint {
     /// `max |q_i|` of every DOF if already known (computed by the tracer of a pipelined
     /// sweep, which would otherwise wait for the worker).
     pub max_abs: Option<Vec<f64>>,
+    /// The error estimate and the multipliers if already known (the exact piecewise
+    /// solution has both).
+    pub estimate: Option<crate::solve::ErrorEstimate>,
+    pub floquet: Option<crate::stability::Floquet>,
 }
 
 impl NewPoint {
@@ -49,6 +53,8 @@ impl NewPoint {
             solution,
             parameter,
             max_abs: None,
+            estimate: None,
+            floquet: None,
         })
     }
 }
@@ -67,6 +73,7 @@ impl Continuation {
         let prev = branch.points.last().and_then(|q| q.floquet.clone());
         let prev_stable = prev.as_ref().map(|f| f.is_stable());
         let (floquet, failure) = match &self.stability {
+            Some(_) if p.floquet.is_some() => (p.floquet, None),
             // Laws with memory: stability unknown (see FloquetOptions::compute), the branch goes on.
             Some(_) if model.memory_element().is_some() => (None, None),
             Some(options) => {
@@ -117,10 +124,11 @@ impl Continuation {
         };
         let max_abs = p.max_abs.unwrap_or_else(|| sol.max_abs_all());
         let truncation = sol.truncation_estimate();
-        let estimate = self
-            .error_estimate
-            .then(|| crate::solve::estimate_error(model, &sol).ok())
-            .flatten();
+        let estimate = p.estimate.or_else(|| {
+            self.error_estimate
+                .then(|| crate::solve::estimate_error(model, &sol).ok())
+                .flatten()
+        });
         let finite = |e: f64| Some(e).filter(|e| e.is_finite());
         let error_estimate = estimate.and_then(|e| finite(e.relative));
         let error_estimate_harmonics = estimate.and_then(|e| finite(e.kept_harmonics));

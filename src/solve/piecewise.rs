@@ -136,6 +136,20 @@ impl ExactSolution {
         self.waveform.extremes()
     }
 
+    /// The stability of the orbit: the exact monodromy matrix's multipliers (no shooting, no
+    /// orbit to correct; a free body's multipliers 1 counted as neutral).
+    pub fn floquet(&self) -> crate::stability::Floquet {
+        crate::stability::Floquet {
+            multipliers: self.multipliers.clone(),
+            neutral: self.neutral,
+            orbit_correction: 0.0,
+            polished: true,
+            orbit_start: Vec::new(),
+            steps: 0,
+            reduction: None,
+        }
+    }
+
     /// The exact `q_i(θ_j)` at `θ_j = 2π j / points` (`[i][j]`), from the closed form.
     pub fn time_series(&self, points: usize) -> Vec<Vec<f64>> {
         self.waveform.time_series(points)

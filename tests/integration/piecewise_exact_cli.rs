@@ -90,3 +90,39 @@ teeth = 1
 profile = { shape = "rectangular", one_tooth = 2.5e5, two_tooth = 5e5, contact_ratio = 1.5 }
 damping = { proportional = 5e-6 }
 "#;
+
+#[test]
+fn a_speed_sweep_with_the_exact_method() {
+    // Evenly spaced speeds, each solved exactly: its own estimate (the harmonics 0..H exact),
+    // extremes from the closed form (5.7589e-5 at 60 rpm, as hbal solve) and the exact
+    // monodromy matrix's multipliers; not harmonic-balance continuation from an exact start.
+    let (code, out, err) = run(&[
+        "sweep",
+        &scene("two_shaft_60rpm.toml"),
+        "--method",
+        "piecewise_exact",
+        "--from",
+        "60",
+        "--to",
+        "600",
+        "--points",
+        "3",
+        "--json",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let points = json["points"].as_array().unwrap();
+    assert_eq!(points.len(), 3);
+    let speeds: Vec<f64> = points
+        .iter()
+        .map(|p| p["speed"].as_f64().unwrap())
+        .collect();
+    assert_eq!(speeds, [60.0, 330.0, 600.0]);
+    for p in points {
+        assert_eq!(p["error_estimate_harmonics"].as_f64(), Some(1e-15), "{p}");
+        assert_eq!(p["orbit_correction"].as_f64(), Some(0.0), "{p}");
+        assert_eq!(p["stable"], true);
+    }
+    let max = points[0]["max_abs"][0].as_f64().unwrap();
+    assert!((max - 5.7589e-5).abs() < 1e-9, "{max:e}");
+}
