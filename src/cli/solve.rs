@@ -200,14 +200,14 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             })),
             // Where max_abs and the elements' extremes come from.
             "extremes_from": match &extremes {
-                Some(x) => json!({"closed_form": {"intervals": x.intervals}}),
+                Some(x) => json!({"closed_form": {"intervals": x.intervals, "resolved": x.resolved}}),
                 None => json!("harmonics"),
             },
             "fundamental_rad_s": sol.basis().omega(),
             "harmonics": sol.basis().harmonics(),
             "samples": sol.basis().samples(),
             "solve_seconds": solve_seconds,
-            "start": opts.start.map(|p| p.display().to_string()),
+            "start": opts.start.filter(|_| exact.is_none()).map(|p| p.display().to_string()),
             "stability": stability_json,
             "dofs": dofs,
             "elements": match &elements {
@@ -225,7 +225,11 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             scene.method.name(),
             sol.stats.iterations,
             if sol.stats.iterations == 1 { "" } else { "s" },
-            if start.is_some() { " from --start" } else { "" },
+            if start.is_some() && exact.is_none() {
+                " from --start"
+            } else {
+                ""
+            },
             sol.residual(),
             solve_seconds * 1e3
         );
@@ -262,8 +266,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         }
         if let Some(x) = &extremes {
             say!(
-                "  extremes from the closed form in time ({} intervals), not from the harmonics 0..{}",
+                "  extremes from the closed form in time ({} intervals{}), not from the harmonics 0..{}",
                 x.intervals,
+                if x.resolved {
+                    ""
+                } else {
+                    "; APPROXIMATE between them: the work budget allows fewer than 32 per period of the fastest motion"
+                },
                 sol.basis().harmonics()
             );
         }

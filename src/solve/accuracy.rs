@@ -336,7 +336,10 @@ fn auto_exact(
             estimate: auto.control.of(&e.estimate),
             seconds: started.elapsed().as_secs_f64(),
         });
-        let reached = auto.control.of(&e.estimate) <= auto.tolerance;
+        // What the solution lacks is a lower bound where the work budget cut its count
+        // short: not a reason to stop (a larger H lifts 2H towards the ringing).
+        let bound_only = e.estimate.lower_bound && auto.control == Control::Solution;
+        let reached = auto.control.of(&e.estimate) <= auto.tolerance && !bound_only;
         let next = 2 * level_basis.harmonics().max(1);
         let capped = !reached && next > auto.max_harmonics;
         if reached || capped {

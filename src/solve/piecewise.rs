@@ -155,12 +155,15 @@ impl ExactSolution {
         self.waveform.time_series(points)
     }
 
-    /// Samples a period needs to show the fastest natural motion (16 per period of the
-    /// highest natural frequency's estimate), at least 256 and at most 65536.
+    /// Samples a period needs to show the fastest motion (16 per period of the highest
+    /// natural frequency's estimate or of the highest load order), at least 256 and at most
+    /// 65536 or what the work budget allows (about 760 for 256 DOFs).
     pub fn resolving_points(&self) -> usize {
         let s = &self.waveform.schedule;
-        let per = (16.0 * s.highest_frequency() / s.omega).ceil();
-        (per.min(65536.0) as usize).max(256)
+        let per = (16.0 * self.waveform.fastest() / s.omega).ceil();
+        // Work about 8 n² per sample, within SERIES_WORK.
+        let affordable = SERIES_WORK / (8.0 * (s.n * s.n) as f64);
+        (per.min(65536.0).min(affordable) as usize).max(256)
     }
 }
 
@@ -276,12 +279,14 @@ impl PiecewiseExact {
         let neutral = 2 * schedule.rigid_modes();
         let Periodic {
             free_start,
+            free_end,
             multipliers,
             ..
         } = periodic;
         let waveform = Waveform {
             schedule,
             free_start,
+            free_end,
             weights: model
                 .elements()
                 .iter()
@@ -297,6 +302,9 @@ impl PiecewiseExact {
         })
     }
 }
+
+/// The work (about `points × 8 n²` operations) of [`ExactSolution::resolving_points`].
+const SERIES_WORK: f64 = 4e8;
 
 /// The work (about `L × configurations × n³` operations) the estimate may spend on orders
 /// beyond 2H.

@@ -46,8 +46,21 @@ impl FreeBody {
             mean[load.dof] += load.cos;
         }
         rigid.check_balance(model, &mean)?;
+        // The elements' couplings w k wᵀ are symmetric; the structural matrices must leave
+        // the modes free from the left as well (Rᵀ K = 0).
+        let modes = rigid.modes();
+        let top = modes.amax();
+        for (name, a) in [("stiffness", &dense.stiffness), ("damping", &dense.damping)] {
+            let left = modes.transpose() * a;
+            if left.amax() > SYMMETRY_TOLERANCE * a.amax().max(f64::MIN_POSITIVE) * top {
+                return Err(Error::InvalidElement {
+                    context: "method `piecewise_exact`".into(),
+                    reason: format!("the model floats free and its {name} matrix is not symmetric in the rigid-body modes (Rᵀ K ≠ 0), so the rigid motion does not separate; use harmonic balance"),
+                });
+            }
+        }
         Ok(Some(Self {
-            modes: rigid.modes().clone(),
+            modes: modes.clone(),
             mass_modes: rigid.mass_modes().clone(),
             rate: 1.0,
         }))
@@ -63,24 +76,12 @@ impl FreeBody {
         self.rate = highest_frequency.max(40.0 / period);
     }
 
-    /// Checks that `k`, `d` leave the modes free from the left as well (`Rᵀ K = 0`: a
-    /// symmetric coupling), and adds the shift `σ S`, `δ S`.
-    pub(super) fn shift(&self, k: &mut DMatrix<f64>, d: &mut DMatrix<f64>) -> Result<()> {
-        let top = self.modes.amax();
-        for (name, a) in [("stiffness", &*k), ("damping", &*d)] {
-            let left = self.modes.transpose() * a;
-            if left.amax() > SYMMETRY_TOLERANCE * a.amax().max(f64::MIN_POSITIVE) * top {
-                return Err(Error::InvalidElement {
-                    context: "method `piecewise_exact`".into(),
-                    reason: format!("the model floats free and its {name} is not symmetric in the rigid-body modes (Rᵀ K ≠ 0), so the rigid motion does not separate; use harmonic balance"),
-                });
-            }
-        }
+    /// Adds the shift `σ S`, `δ S` to a piece's `k`, `d`.
+    pub(super) fn shift(&self, k: &mut DMatrix<f64>, d: &mut DMatrix<f64>) {
         let (a, b) = (self.rate, 2.0 * self.rate);
         let s = &self.mass_modes * self.mass_modes.transpose();
         *k += &s * (a * b);
         *d += &s * (a + b);
-        Ok(())
     }
 
     /// Splits the load harmonic `block` of `order` into the flexible part `Pᵀ F` (in place)

@@ -160,7 +160,7 @@ impl Schedule {
         }
         for (coefficients, mut k, mut d) in systems {
             if let Some(free) = &schedule.free_body {
-                free.shift(&mut k, &mut d)?;
+                free.shift(&mut k, &mut d);
             }
             let mut config = schedule.configuration(model, &inverse, &coefficients, k, d)?;
             config.elements = coefficients;
@@ -299,6 +299,11 @@ fn checked(model: &Model) -> Result<(crate::model::DenseMatrices, Option<FreeBod
         }
     }
     let dense = model.dense("piecewise_exact")?;
+    if dense.mass.clone().lu().try_inverse().is_none() {
+        return Err(Error::MassNotPositiveDefinite {
+            reason: "singular (the exact piecewise solution needs M⁻¹)".into(),
+        });
+    }
     let free_body = FreeBody::find(model, &dense)?;
     Ok((dense, free_body))
 }
@@ -340,6 +345,26 @@ impl Configuration {
             }
         }
         x
+    }
+
+    /// `∫ q_s dt` of the steady state over the angles `a..b`:
+    /// `Re Σ_k Q_k (e^{ikb} - e^{ika}) / (ikΩ)`, `Q_0 (b - a)/Ω`.
+    pub(super) fn steady_integral(&self, a: f64, b: f64, omega: f64) -> DVector<f64> {
+        let n = self.n;
+        let mut out = DVector::zeros(n);
+        for (order, block) in self.steady.chunks(n).enumerate() {
+            let factor = if order == 0 {
+                Complex64::new((b - a) / omega, 0.0)
+            } else {
+                let k = order as f64;
+                (Complex64::from_polar(1.0, k * b) - Complex64::from_polar(1.0, k * a))
+                    / Complex64::new(0.0, k * omega)
+            };
+            for (o, q) in out.iter_mut().zip(block) {
+                *o += (q * factor).re;
+            }
+        }
+        out
     }
 
     /// The steady state and its first three time derivatives at angle `θ`:

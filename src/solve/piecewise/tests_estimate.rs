@@ -96,9 +96,7 @@ fn an_estimate_cut_short_by_the_work_budget_says_it_is_a_lower_bound() {
     assert!(e.relative > 1e-4 && e.relative.is_finite(), "{e:?}");
     // The chain at 6000 rad/s: the ringing is within reach, the estimate is whole.
     let basis = HarmonicBasis::new(6000.0, 8).unwrap();
-    let e = PiecewiseExact::new()
-        .solve_exact(&model, &basis)
-        .unwrap()
-        .estimate;
-    assert!(!e.lower_bound, "{e:?}");
+    let exact = PiecewiseExact::new().solve_exact(&model, &basis).unwrap();
+    assert!(!exact.estimate.lower_bound, "{:?}", exact.estimate);
+    assert!(exact.extremes().resolved);
 }

@@ -10,9 +10,11 @@
 //! `k u + d u̇ + f_0` of the piece's coefficients) is known there with `g'` and `g''`; between
 //! two ends the quintic Hermite interpolant (error `O(δ⁶ g⁽⁶⁾)`, about 1e-9 of the ringing's
 //! amplitude at 32 intervals per period) locates an interior extremum where `g'` changes
-//! sign, and integrates `g` exactly to `O(δ⁷)`:
-//! `∫_0^δ g = δ/2 (g_0 + g_1) + δ²/10 (g'_0 - g'_1) + δ³/120 (g''_0 + g''_1)`.
-//! A force that jumps at a piece's end is evaluated on both sides of it.
+//! sign. A force that jumps at a piece's end is evaluated on both sides of it. The mean forces
+//! come from the closed form's integral over each piece: `∫ q dt` is the steady part's
+//! `Re Σ_k Q_k (e^{ikb} - e^{ika}) / (ikΩ)` plus the free motion's
+//! `-K_p⁻¹ (M Δq̇_f + D_p Δq_f)` (the equation of motion integrated over the piece), and
+//! `∫ u̇ dt = u(b) - u(a)`; exact whatever the intervals.
 
 use super::schedule::{Configuration, Schedule};
 use crate::stability::expm::ExpWork;
@@ -50,6 +52,10 @@ pub struct ExactExtremes {
     pub elements: Vec<ElementExtremes>,
     /// Intervals the period was cut into.
     pub intervals: usize,
+    /// `false` where the work budget (large models) left fewer than 32 intervals per period
+    /// of the fastest motion: the extremes between the grid's points are then approximate
+    /// (the mean forces stay exact).
+    pub resolved: bool,
 }
 
 /// The schedule and the free motion at every piece's start: all that is needed to evaluate
@@ -58,6 +64,8 @@ pub(super) struct Waveform {
     pub(super) schedule: Schedule,
     /// `h_p` in `(q, q̇)`.
     pub(super) free_start: Vec<DVector<f64>>,
+    /// `Φ_p h_p`, the free motion at the piece's end.
+    pub(super) free_end: Vec<DVector<f64>>,
     /// Every element's weights `w` (`u = w·q`).
     pub(super) weights: Vec<Vec<(usize, f64)>>,
 }
@@ -83,16 +91,38 @@ impl Waveform {
         }
         let spacing = TAU / points as f64;
         let mut work = ExpWork::new(2 * n);
-        let (mut step, mut lead) = (DMatrix::zeros(2 * n, 2 * n), DMatrix::zeros(2 * n, 2 * n));
-        for (piece, h) in s.pieces.iter().zip(&self.free_start) {
-            // Pieces cover [θ_0, θ_0 + 2π): sample j' lies in this one, index j' mod points.
-            let first = (piece.start / spacing).ceil() as usize;
-            let end = (piece.end / spacing).ceil() as usize;
+        // One step e^{A_c δ} per configuration.
+        let steps: Vec<DMatrix<f64>> = s
+            .configurations
+            .iter()
+            .map(|c| {
+                let mut step = DMatrix::zeros(2 * n, 2 * n);
+                work.exp(&c.generator, spacing / omega, &mut step);
+                step
+            })
+            .collect();
+        let mut lead = DMatrix::zeros(2 * n, 2 * n);
+        // Pieces cover [θ_0, θ_0 + 2π): sample j' lies in piece p for
+        // index(θ_p) <= j' < index(θ_{p+1}), the last piece ending at index(θ_0) + points so
+        // that every sample j' mod points is written once, whatever the rounding.
+        let index = |theta: f64| (theta / spacing).ceil() as usize;
+        let first_index = index(s.pieces[0].start);
+        let last = s.pieces.len() - 1;
+        for (p, (piece, h)) in s.pieces.iter().zip(&self.free_start).enumerate() {
+            let first = if p == 0 {
+                first_index
+            } else {
+                index(piece.start)
+            };
+            let end = if p == last {
+                first_index + points
+            } else {
+                index(piece.end)
+            };
             if first >= end {
                 continue;
             }
             let config = &s.configurations[piece.configuration];
-            work.exp(&config.generator, spacing / omega, &mut step);
             let theta = first as f64 * spacing;
             work.exp(&config.generator, (theta - piece.start) / omega, &mut lead);
             let mut scaled = &lead * s.scale_state(h.clone());
@@ -103,7 +133,7 @@ impl Waveform {
                 for (i, row) in out.iter_mut().enumerate() {
                     row[j % points] = steady[i] + x[i];
                 }
-                scaled = &step * scaled;
+                scaled = &steps[piece.configuration] * scaled;
             }
         }
         out
@@ -139,6 +169,52 @@ impl Tracker {
 }
 
 impl Waveform {
+    /// The fastest motion's angular frequency: the highest natural frequency's estimate or
+    /// the highest load order's.
+    pub(super) fn fastest(&self) -> f64 {
+        let s = &self.schedule;
+        s.highest_frequency()
+            .max(s.model_load_orders as f64 * s.omega)
+    }
+
+    /// Every element's mean force `(1/T) Σ_p ∫ (k_e u + d_e u̇ + f_e) dt`, exactly: on a
+    /// piece `∫ q dt` is the steady part's `Re Σ_k Q_k (e^{ikb} - e^{ika}) / (ikΩ)` (`Q_0 τ`)
+    /// plus the free motion's `-K_p⁻¹ (M Δq̇_f + D_p Δq_f)` (the equation of motion
+    /// integrated over the piece), and `∫ u̇ dt = u(b) - u(a)`.
+    fn mean_forces(&self) -> Vec<f64> {
+        let s = &self.schedule;
+        let (n, omega) = (s.n, s.omega);
+        let stiffness: Vec<_> = s
+            .configurations
+            .iter()
+            .map(|c| c.stiffness.clone().lu())
+            .collect();
+        let mut sums = vec![0.0; self.weights.len()];
+        for ((piece, h), e) in s.pieces.iter().zip(&self.free_start).zip(&self.free_end) {
+            let config = &s.configurations[piece.configuration];
+            let (a, b) = (piece.start, piece.end);
+            let delta = e - h;
+            let rhs = &s.mass * delta.rows(n, n) + &config.damping * delta.rows(0, n);
+            let free = stiffness[piece.configuration]
+                .solve(&rhs)
+                .unwrap_or_else(|| DVector::zeros(n));
+            let integral = config.steady_integral(a, b, omega) - free;
+            let change = config.steady_state(b, omega).rows(0, n)
+                - config.steady_state(a, omega).rows(0, n)
+                + delta.rows(0, n);
+            let gather = |w: &[(usize, f64)], y: &DVector<f64>| -> f64 {
+                w.iter().map(|&(i, c)| c * y[i]).sum()
+            };
+            for ((sum, w), &(k, d, f0)) in sums.iter_mut().zip(&self.weights).zip(&config.elements)
+            {
+                *sum +=
+                    k * gather(w, &integral) + d * gather(w, &change) + f0 * piece.duration(omega);
+            }
+        }
+        let period = TAU / omega;
+        sums.iter().map(|v| v / period).collect()
+    }
+
     /// The extremes and mean forces over the period.
     pub(super) fn extremes(&self) -> ExactExtremes {
         let s = &self.schedule;
@@ -152,10 +228,10 @@ impl Waveform {
             };
             signals
         ];
-        let mut integral = vec![0.0; m];
-        // Intervals per second: PER_PERIOD per fastest period, within the work budget.
+        // Intervals per second: PER_PERIOD per period of the fastest motion (the highest
+        // natural frequency or the highest load order), within the work budget.
         let period = TAU / omega;
-        let wanted = PER_PERIOD * s.highest_frequency() / TAU;
+        let wanted = PER_PERIOD * self.fastest() / TAU;
         let affordable = WORK / (12.0 * (n * n) as f64 * period);
         let rate = wanted.min(affordable);
         let mut work = ExpWork::new(2 * n);
@@ -194,12 +270,6 @@ impl Waveform {
                             }
                         }
                     }
-                    for (e, sum) in integral.iter_mut().enumerate() {
-                        let (a, b) = (before[n + m + e], jets[n + m + e]);
-                        *sum += dt / 2.0 * (a[0] + b[0])
-                            + dt * dt / 10.0 * (a[1] - b[1])
-                            + dt * dt * dt / 120.0 * (a[2] + b[2]);
-                    }
                 }
                 std::mem::swap(&mut buffers.now, &mut buffers.before);
                 if j < intervals {
@@ -208,6 +278,7 @@ impl Waveform {
                 }
             }
         }
+        let means = self.mean_forces();
         let range = |t: &Tracker| (t.min, t.max);
         ExactExtremes {
             dofs: track[..n].iter().map(range).collect(),
@@ -215,10 +286,11 @@ impl Waveform {
                 .map(|e| ElementExtremes {
                     coordinate: range(&track[n + e]),
                     force: range(&track[n + m + e]),
-                    force_mean: integral[e] / period,
+                    force_mean: means[e],
                 })
                 .collect(),
             intervals: total,
+            resolved: wanted <= affordable,
         }
     }
 }

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::catalog::TwoShaft;
-use crate::force::LinearSpring;
+use crate::force::{LinearSpring, MeshDamping, MeshProfile, MeshStiffness};
 use crate::solve::PiecewiseExact;
 use crate::{HarmonicBasis, Model};
 
@@ -103,4 +103,79 @@ fn the_time_series_is_the_time_domains() {
         .fold(0.0f64, f64::max);
     assert!(off > 0.1 * scale, "{:.2e}", off / scale);
     assert!(exact.resolving_points() >= 256);
+}
+
+#[test]
+fn every_sample_is_written_when_a_jump_falls_on_the_grid() {
+    // The first jump on a sample (phase 2π - 2π k/points, as a user writes a phase near 2π):
+    // the pieces' sample ranges still cover every sample once (a rounding had left one at
+    // 0.0, found in review with phase 2π - 2π/500).
+    for points in [64, 256, 500, 1000] {
+        let phases = (1..40)
+            .flat_map(|k| [k as f64, points as f64 - k as f64])
+            .map(|k| TAU - TAU * k / points as f64)
+            // The review's case (with 1000 samples).
+            .chain([6.270618936565227]);
+        for phase in phases {
+            let mesh = MeshStiffness::new(
+                1,
+                MeshProfile::Rectangular {
+                    one_tooth: 2.5e5,
+                    two_tooth: 5e5,
+                    contact_ratio: 1.5,
+                },
+                MeshDamping::Proportional(5e-6),
+            )
+            .with_phase(phase);
+            let model = Model::builder(&["gear"])
+                .mass_diagonal(&[1e-3])
+                .element("mesh", &[("gear", 1.0)], mesh)
+                .load("gear", 0, 10.0, 0.0)
+                .load("gear", 1, 3.0, 0.0)
+                .build()
+                .unwrap();
+            let exact = PiecewiseExact::new()
+                .solve_exact(&model, &HarmonicBasis::new(2513.0, 8).unwrap())
+                .unwrap();
+            let series = exact.time_series(points);
+            let (lo, hi) = exact.extremes().dofs[0];
+            for (j, q) in series[0].iter().enumerate() {
+                assert!(
+                    *q >= lo - 1e-12 * hi && *q <= hi + 1e-12 * hi && *q > 0.0,
+                    "points {points}, phase {phase}, sample {j}: {q:e} outside [{lo:e}, {hi:e}]"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_load_faster_than_the_natural_frequencies_sets_the_resolution() {
+    // m = k = 1, d = 0.1, a load at order 40 of Ω = 1: q = Q0 + |Q40| cos(...), its extremes
+    // need intervals per load period, not per natural period.
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .damping_triplets(&[(0, 0, 0.1)])
+        .element("spring", &[("x", 1.0)], LinearSpring::new(1.0, 0.0))
+        .load("x", 0, 0.5, 0.0)
+        .load("x", 40, 1.0, 0.0)
+        .build()
+        .unwrap();
+    let exact = PiecewiseExact::new()
+        .solve_exact(&model, &HarmonicBasis::new(1.0, 40).unwrap())
+        .unwrap();
+    let q = exact.solution.harmonics();
+    let x = exact.extremes();
+    let (lo, hi) = (q[0].re - q[40].norm(), q[0].re + q[40].norm());
+    assert!(
+        (x.dofs[0].1 - hi).abs() < 1e-9 * hi,
+        "{:e} against {hi:e}",
+        x.dofs[0].1
+    );
+    assert!(
+        (x.dofs[0].0 - lo).abs() < 1e-9 * hi,
+        "{:e} against {lo:e}",
+        x.dofs[0].0
+    );
+    assert!(x.resolved && exact.resolving_points() >= 16 * 40);
 }
