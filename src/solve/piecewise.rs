@@ -69,6 +69,7 @@ use crate::HarmonicBasis;
 use num_complex::Complex64;
 use std::time::Instant;
 
+mod admission;
 mod factor;
 pub mod free_body;
 mod periodic;
