@@ -295,14 +295,18 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 .filter_map(|p| p.error_estimate_harmonics)
                 .fold(f64::NAN, f64::max);
             say!(
-                "  largest error estimate {e:.1e} (at {:.6} {unit}){} (against 2H = {})",
+                "  largest error estimate {e:.1e} (at {:.6} {unit}){} ({})",
                 speed(w),
                 if kept.is_nan() {
                     String::new()
                 } else {
                     format!(", of harmonics 0..{} {kept:.1e}", branch.harmonics)
                 },
-                2 * branch.harmonics
+                if matches!(scene.method, hbal::solve::Method::PiecewiseExact(_)) {
+                    "what the exact solution lacks above H, and rounding".to_string()
+                } else {
+                    format!("against 2H = {}", 2 * branch.harmonics)
+                }
             );
         }
         let failed_start = matches!(branch.stop, BranchStop::StartFailed { .. });
