@@ -134,11 +134,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let stability_seconds = started.elapsed().as_secs_f64();
     // Extremes of the exact method from its closed form, else from the harmonics.
     let max_abs = match &extremes {
-        Some(x) => x
-            .dofs
-            .iter()
-            .map(|(lo, hi)| lo.abs().max(hi.abs()))
-            .collect(),
+        Some(x) => x.max_abs(),
         None => sol.max_abs_all(),
     };
     let elements = hbal::report::element_outputs(&scene.model, &sol)

@@ -44,7 +44,7 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
     let formulation = cont.formulation;
     for (i, &p) in values.iter().enumerate() {
         let (model, basis) = match build(p) {
-            Ok((m, b)) => (m, b),
+            Ok(v) => v,
             Err(e) => match branch.as_mut() {
                 // Keep the points so far.
                 Some(b) => {
@@ -138,13 +138,7 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
             |mut point| {
                 // The exact solution's own estimate, extremes and multipliers.
                 if let Some(e) = exact.take() {
-                    point.max_abs = Some(
-                        e.extremes()
-                            .dofs
-                            .iter()
-                            .map(|(lo, hi)| lo.abs().max(hi.abs()))
-                            .collect(),
-                    );
+                    point.max_abs = Some(e.extremes().max_abs());
                     point.estimate = Some(e.estimate);
                     point.floquet = Some(e.floquet());
                 }

@@ -17,7 +17,7 @@
 //! list, the rigid body's own `2p` multipliers 1 counted as neutral.
 
 use crate::error::{Error, Result};
-use crate::model::{DenseMatrices, Model};
+use crate::model::{DenseMatrices, Model, RigidModes};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -26,10 +26,8 @@ const SYMMETRY_TOLERANCE: f64 = 1e-9;
 
 /// The rigid-body modes of a free-floating model and the shift that makes it regular.
 pub(super) struct FreeBody {
-    /// `R`, M-orthonormal.
-    modes: DMatrix<f64>,
-    /// `M R`.
-    mass_modes: DMatrix<f64>,
+    /// `R` (M-orthonormal) and `M R`.
+    rigid: RigidModes,
     /// The shift's slower rate `a` (1/s); the other is `2a`.
     rate: f64,
 }
@@ -59,16 +57,12 @@ impl FreeBody {
                 });
             }
         }
-        Ok(Some(Self {
-            modes: modes.clone(),
-            mass_modes: rigid.mass_modes().clone(),
-            rate: 1.0,
-        }))
+        Ok(Some(Self { rigid, rate: 1.0 }))
     }
 
     /// The number `p` of rigid-body modes.
     pub(super) fn count(&self) -> usize {
-        self.modes.ncols()
+        self.rigid.len()
     }
 
     /// Sets the shift's rate from the highest natural frequency's estimate and the period.
@@ -79,7 +73,8 @@ impl FreeBody {
     /// Adds the shift `σ S`, `δ S` to a piece's `k`, `d`.
     pub(super) fn shift(&self, k: &mut DMatrix<f64>, d: &mut DMatrix<f64>) {
         let (a, b) = (self.rate, 2.0 * self.rate);
-        let s = &self.mass_modes * self.mass_modes.transpose();
+        let mass_modes = self.rigid.mass_modes();
+        let s = mass_modes * mass_modes.transpose();
         *k += &s * (a * b);
         *d += &s * (a + b);
     }
@@ -92,21 +87,17 @@ impl FreeBody {
         order: usize,
         omega: f64,
     ) -> Vec<Complex64> {
-        let n = block.len();
-        let mut rigid = vec![Complex64::new(0.0, 0.0); n];
-        for c in 0..self.count() {
-            let r = self.modes.column(c);
-            let f: Complex64 = r.iter().zip(block.iter()).map(|(ri, fi)| fi * *ri).sum();
-            for (b, mr) in block.iter_mut().zip(self.mass_modes.column(c).iter()) {
-                *b -= f * *mr;
-            }
-            if order > 0 {
-                let w = order as f64 * omega;
+        let mut rigid = vec![Complex64::new(0.0, 0.0); block.len()];
+        if order > 0 {
+            let w2 = (order as f64 * omega).powi(2);
+            for r in self.rigid.modes().column_iter() {
+                let f: Complex64 = r.iter().zip(block.iter()).map(|(ri, fi)| fi * *ri).sum();
                 for (x, ri) in rigid.iter_mut().zip(r.iter()) {
-                    *x -= f * *ri / (w * w);
+                    *x -= f * *ri / w2;
                 }
             }
         }
+        self.rigid.project_load(block);
         rigid
     }
 }

@@ -58,6 +58,16 @@ pub struct ExactExtremes {
     pub resolved: bool,
 }
 
+impl ExactExtremes {
+    /// `max |q_i|` of every DOF.
+    pub fn max_abs(&self) -> Vec<f64> {
+        self.dofs
+            .iter()
+            .map(|(lo, hi)| lo.abs().max(hi.abs()))
+            .collect()
+    }
+}
+
 /// The schedule and the free motion at every piece's start: all that is needed to evaluate
 /// the exact solution anywhere.
 pub(super) struct Waveform {
@@ -141,9 +151,6 @@ impl Waveform {
             let change = config.steady_state(b, omega).rows(0, n)
                 - config.steady_state(a, omega).rows(0, n)
                 + delta.rows(0, n);
-            let gather = |w: &[(usize, f64)], y: &DVector<f64>| -> f64 {
-                w.iter().map(|&(i, c)| c * y[i]).sum()
-            };
             for ((sum, w), &(k, d, f0)) in sums.iter_mut().zip(&self.weights).zip(&config.elements)
             {
                 *sum +=
@@ -286,9 +293,6 @@ impl JetBuffers {
         for (i, out) in self.now[..n].iter_mut().enumerate() {
             *out = [q[i], v[i], a[i]];
         }
-        let gather = |w: &[(usize, f64)], y: &DVector<f64>| -> f64 {
-            w.iter().map(|&(i, c)| c * y[i]).sum()
-        };
         let m = weights.len();
         for (e, (w, &(k, d, f0))) in weights.iter().zip(&config.elements).enumerate() {
             let u = [gather(w, q), gather(w, v), gather(w, a), gather(w, j)];
@@ -300,6 +304,11 @@ impl JetBuffers {
             ];
         }
     }
+}
+
+/// `u = w·y` of an element with weights `w`.
+fn gather(w: &[(usize, f64)], y: &DVector<f64>) -> f64 {
+    w.iter().map(|&(i, c)| c * y[i]).sum()
 }
 
 /// The value at an interior extremum of the quintic Hermite interpolant between `a` and `b`
