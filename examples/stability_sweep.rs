@@ -21,7 +21,7 @@ mod common;
 use common::{cpu_ms, flag, median, process_cpu_ms};
 use hbal::continuation::{Branch, Continuation};
 use hbal::scene::Scene;
-use hbal::stability::FloquetOptions;
+use hbal::stability::{FloquetOptions, Orbit};
 use std::path::Path;
 use std::time::Instant;
 
@@ -65,6 +65,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (wall_hb, cpu_hb, all_hb, plain) = run(None)?;
     let options = FloquetOptions {
         cutoff: flag(&args, "--cutoff", FloquetOptions::default().cutoff),
+        orbit: if args.iter().any(|a| a == "harmonic") {
+            Orbit::Harmonic
+        } else {
+            Orbit::Exact
+        },
         ..FloquetOptions::default()
     };
     let (wall, cpu, all, branch) = run(Some(options))?;
@@ -176,9 +181,11 @@ fn dump(branch: &Branch) {
                 .map(|m| format!("{:.15e},{:.15e}", m.re, m.im))
                 .collect();
             eprintln!(
-                "{:.6} steps {} corr {:.2e} polished {} mu {}",
+                "{:.6} steps {} orbit {:?} difference {:?} corr {:.2e} polished {} mu {}",
                 p.omega,
                 f.steps,
+                f.orbit,
+                f.orbit_difference,
                 f.orbit_correction,
                 f.polished,
                 mu.join(" ")

@@ -75,6 +75,13 @@ enum Command {
         /// Skip the Floquet stability of the points.
         #[arg(long)]
         no_stability: bool,
+        /// The orbit whose Floquet multipliers a point gets: `exact` (shooting onto the exact
+        /// periodic orbit) or `harmonic` (the HB orbit's own pieces, no integration: a
+        /// fraction of the cost where every law is piecewise affine; checked against the
+        /// exact orbit along the way, and the exact orbit's where a multiplier is too close
+        /// to the unit circle to call).
+        #[arg(long, default_value = "exact", value_parser = parse_orbit)]
+        stability_orbit: hbal::stability::Orbit,
         /// Stop after this many points (exit code 1 if --to is not reached; default 2000, at
         /// most 100000).
         #[arg(long, value_parser = sweep_points(1))]
@@ -178,6 +185,15 @@ enum Command {
 const MAX_SWEEP_POINTS: u64 = 100_000;
 
 /// A point count from `min` to [`MAX_SWEEP_POINTS`].
+/// `exact` or `harmonic`.
+fn parse_orbit(s: &str) -> Result<hbal::stability::Orbit, String> {
+    match s {
+        "exact" => Ok(hbal::stability::Orbit::Exact),
+        "harmonic" => Ok(hbal::stability::Orbit::Harmonic),
+        _ => Err(format!("`{s}`: expected `exact` or `harmonic`")),
+    }
+}
+
 fn sweep_points(min: u64) -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::new().range(min..=MAX_SWEEP_POINTS)
 }
@@ -260,6 +276,7 @@ fn main() -> ExitCode {
             solver,
             start,
             no_stability,
+            stability_orbit,
             max_points,
             json,
             out,
@@ -271,6 +288,16 @@ fn main() -> ExitCode {
             output,
             dofs,
         } => match parameter {
+            _ if no_stability && stability_orbit != hbal::stability::Orbit::Exact => {
+                Err(cli::Failure::from(anyhow::anyhow!(
+                    "--stability-orbit chooses the orbit of the points' stability; drop --no-stability or --stability-orbit"
+                )))
+            }
+            Some(_) if stability_orbit != hbal::stability::Orbit::Exact => {
+                Err(cli::Failure::from(anyhow::anyhow!(
+                    "--stability-orbit applies to speed sweeps, not to --parameter sweeps"
+                )))
+            }
             Some(_) if output.is_some() => Err(cli::Failure::from(anyhow::anyhow!(
                 "--output chooses the order-cut plot of a speed sweep; it does not apply to --parameter sweeps"
             ))),
@@ -300,6 +327,7 @@ fn main() -> ExitCode {
                     to,
                     start: start.as_deref(),
                     stability: !no_stability,
+                    orbit: stability_orbit,
                     max_points,
                     max_step,
                     points,

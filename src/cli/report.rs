@@ -95,6 +95,7 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
                     to,
                     start: None,
                     stability: opts.stability,
+                    orbit: hbal::stability::Orbit::Exact,
                     max_points: None,
                     max_step: 0.5,
                     points: 101,

@@ -19,6 +19,8 @@ pub(crate) struct SweepOptions<'a> {
     pub(crate) to: f64,
     pub(crate) start: Option<&'a Path>,
     pub(crate) stability: bool,
+    /// The orbit of the points' stability (`--stability-orbit`).
+    pub(crate) orbit: hbal::stability::Orbit,
     pub(crate) max_points: Option<usize>,
     pub(crate) max_step: f64,
     /// Evenly spaced speeds of a sweep with the exact piecewise solution (no continuation).
@@ -164,11 +166,12 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         method: scene.method,
         tolerance: args.tolerance.unwrap_or(defaults.tolerance),
         max_points: opts.max_points.unwrap_or(defaults.max_points),
-        stability: if opts.stability {
-            defaults.stability
-        } else {
-            None
-        },
+        stability: defaults.stability.filter(|_| opts.stability).map(|f| {
+            hbal::stability::FloquetOptions {
+                orbit: opts.orbit,
+                ..f
+            }
+        }),
         error_estimate: opts.error_estimate,
         formulation: args.formulation,
         ..defaults
@@ -265,6 +268,9 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 String::new()
             }
         );
+        if let Some(line) = super::sweep_summary::orbit_line(&branch) {
+            say!("  {line}");
+        }
         if let Some(e) = scene.model.memory_element().filter(|_| opts.stability) {
             say!(
                 "  stability unknown: not available for laws with memory (element `{}`)",

@@ -4,6 +4,7 @@
 
 use super::multipliers_json;
 use hbal::continuation::{Branch, BranchPoint};
+use hbal::stability::Orbit;
 use serde_json::json;
 
 /// One point of a branch as JSON; harmonic k of a branch with period multiple ν is order
@@ -39,6 +40,8 @@ pub(crate) fn point_json(
         "neutral": f.map(|f| f.neutral),
         "orbit_correction": f.map(|f| f.orbit_correction),
         "polished": f.map(|f| f.polished),
+        "stability_orbit": f.map(|f| f.orbit),
+        "orbit_difference": f.and_then(|f| f.orbit_difference),
         "harmonics": reported.iter().filter(|&&i| i < n).map(|&i| (0..=branch.harmonics).map(|k| {
             let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
             let shaft_order = super::element_report::order_of(k, fundamental_order, nu);
@@ -49,6 +52,28 @@ pub(crate) fn point_json(
             }
         }).collect::<Vec<_>>()).collect::<Vec<_>>(),
     })
+}
+
+/// The summary line of the HB orbit's stability ([`Orbit::Harmonic`]): how many points have
+/// the HB orbit's multipliers and the largest difference to the exact orbit's measured on the
+/// way; `None` where every point has the exact orbit's.
+pub(crate) fn orbit_line(branch: &Branch) -> Option<String> {
+    let harmonic: Vec<f64> = branch
+        .points
+        .iter()
+        .filter_map(|p| p.floquet.as_ref())
+        .filter(|f| f.orbit == Orbit::Harmonic)
+        .map(|f| f.orbit_difference.unwrap_or(f64::NAN))
+        .collect();
+    if harmonic.is_empty() {
+        return None;
+    }
+    let largest = harmonic.iter().copied().fold(0.0, f64::max);
+    Some(format!(
+        "stability of the HB orbit at {} of {} points (the others the exact orbit's); multipliers within {largest:.1e} of the exact orbit's where measured",
+        harmonic.len(),
+        branch.points.len()
+    ))
 }
 
 /// A secondary branch as JSON: where it leaves the main branch, its period multiple, its

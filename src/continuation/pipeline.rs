@@ -58,9 +58,16 @@ impl Sink<'_> {
         match self {
             Sink::Direct(branch) => continuation.append(branch, model, traced),
             Sink::Worker { tx, len } => {
-                // The max |q| of every DOF here, the stability on the worker.
+                // The max |q| of every DOF here, the stability on the worker; with the HB
+                // orbit's stability (a third of the exact orbit's work) the worker has time
+                // for both, and the tracer is the slower thread.
                 let mut traced = traced;
-                traced.point.max_abs = Some(traced.point.solution.max_abs_all());
+                let harmonic = continuation
+                    .stability
+                    .is_some_and(|s| s.orbit == crate::stability::Orbit::Harmonic);
+                if !harmonic {
+                    traced.point.max_abs = Some(traced.point.solution.max_abs_all());
+                }
                 if tx.send(traced).is_err() {
                     return Some("stability failed at an earlier point".to_string());
                 }

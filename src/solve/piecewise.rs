@@ -148,6 +148,8 @@ impl ExactSolution {
             orbit_start: Vec::new(),
             steps: 0,
             reduction: None,
+            orbit: crate::stability::Orbit::Exact,
+            orbit_difference: None,
         }
     }
 

@@ -5,10 +5,11 @@
 
 use super::chord::KeptJacobian;
 use super::kept::KeptGenerators;
+use super::orbit_check::OrbitCheck;
 use super::reduction::{reduced_basis, ModeCache};
 use super::shooting::{distance, hb_start, shoot, Goal, Shot, Start};
 use super::system::Coordinates;
-use super::{Floquet, FloquetOptions};
+use super::{Floquet, FloquetOptions, Orbit};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solution::Solution;
@@ -148,6 +149,33 @@ impl FloquetOptions {
             }
         };
         let omega = solution.basis().omega();
+        let mut floquet = match self.orbit {
+            Orbit::Exact => self.exact_orbit(&sys, solution, cache, omega)?,
+            Orbit::Harmonic => self.harmonic_orbit(&sys, solution, cache, omega)?,
+        };
+        if let Some(mut info) = reduction {
+            if info.dofs >= n {
+                info.estimate = Some(0.0);
+            }
+            floquet.reduction = Some(info);
+            if self.estimate {
+                self.add_estimate(model, solution, &mut floquet, cache)?;
+            }
+        }
+        Ok(floquet)
+    }
+
+    /// The multipliers of the exact orbit next to `solution` in the coordinates `sys`, by
+    /// shooting: from the previous points' corrections (extrapolated along the last three) if
+    /// that converges near, from the HB state otherwise.
+    pub(super) fn exact_orbit(
+        &self,
+        sys: &Coordinates,
+        solution: &Solution,
+        cache: &mut FloquetCache,
+        omega: f64,
+    ) -> Result<Floquet> {
+        let n = sys.model.n_dofs();
         // Start from the previous points' corrections (extrapolated along the last three)
         // if it is near; from the HB state if that fails to converge. The chord steps start
         // with the previous point's monodromy matrix.
@@ -158,7 +186,7 @@ impl FloquetOptions {
             .flatten();
         if let Some(d) = predicted {
             let s = shoot(
-                &sys,
+                sys,
                 solution,
                 self,
                 Start::Corrected(&d),
@@ -175,7 +203,7 @@ impl FloquetOptions {
         let shot = match shot {
             Some(s) => s,
             None => shoot(
-                &sys,
+                sys,
                 solution,
                 self,
                 Start::Hb,
@@ -184,9 +212,7 @@ impl FloquetOptions {
                 &mut cache.generators,
             )?,
         };
-        let Shot {
-            mut floquet, kappa, ..
-        } = shot;
+        let Shot { floquet, kappa, .. } = shot;
         cache.kappa = kappa.or(cache.kappa);
         cache.jacobian = Some(shot.jacobian);
         let correction = floquet.polished.then(|| {
@@ -203,15 +229,6 @@ impl FloquetOptions {
                 cache.corrections.push(c);
             }
             None => cache.corrections.clear(),
-        }
-        if let Some(mut info) = reduction {
-            if info.dofs >= n {
-                info.estimate = Some(0.0);
-            }
-            floquet.reduction = Some(info);
-            if self.estimate {
-                self.add_estimate(model, solution, &mut floquet, cache)?;
-            }
         }
         Ok(floquet)
     }
@@ -304,15 +321,17 @@ impl FloquetOptions {
 /// shooting that measured it.
 #[derive(Debug, Clone, Default)]
 pub struct FloquetCache {
-    modes: ModeCache,
+    pub(super) modes: ModeCache,
     /// The exponential flow's generators of the last point.
-    generators: KeptGenerators,
+    pub(super) generators: KeptGenerators,
     /// The last orbit corrections `(Ω, (δq, δq̇))`, oldest first.
-    corrections: Vec<(f64, Vec<f64>)>,
-    jacobian: Option<KeptJacobian>,
-    kappa: Option<f64>,
+    pub(super) corrections: Vec<(f64, Vec<f64>)>,
+    pub(super) jacobian: Option<KeptJacobian>,
+    pub(super) kappa: Option<f64>,
     /// How long the last point's analysis took (set by the sweep that owns the cache).
     last_time: Option<std::time::Duration>,
+    /// The last measurement of the HB orbit's multipliers against the exact orbit's.
+    pub(super) orbit_check: Option<OrbitCheck>,
 }
 
 /// Orbit corrections kept for the next point's prediction (a quadratic in Ω).

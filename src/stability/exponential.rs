@@ -49,13 +49,13 @@ use nalgebra::{DMatrix, DVector};
 pub(crate) struct ExpFlow<'c, 'm> {
     pub(super) sys: &'c Coordinates<'m>,
     pub(super) n: usize,
-    omega: f64,
-    bounds: Vec<f64>,
+    pub(super) omega: f64,
+    pub(super) bounds: Vec<f64>,
     pub(super) pieces: Pieces,
     pub(super) scale_q: f64,
     pub(super) scale_v: f64,
     /// The sub-step δ₀ (a power of two).
-    delta0: f64,
+    pub(super) delta0: f64,
     max_steps: usize,
     /// `Ã` of the structure alone.
     base: DMatrix<f64>,
@@ -79,11 +79,14 @@ pub(crate) struct ExpFlow<'c, 'm> {
     /// The monodromy side, here or (linked) on another thread.
     pub(super) assembler: Box<Assembler>,
     pub(super) link: Option<Box<Link>>,
+    /// The orbit is not integrated ([`ExpFlow::along_harmonics`]): the generators' states
+    /// leave out the load's part `X_δ₀`.
+    pub(super) monodromy_only: bool,
 }
 
 /// A piece: its generator and the laws' coefficients `(f0_e, k_e, d_e)`.
-struct Piece {
-    state: usize,
+pub(super) struct Piece {
+    pub(super) state: usize,
     coefficients: Vec<(f64, f64, f64)>,
 }
 
@@ -154,11 +157,12 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
             steps: 0,
             assembler,
             link: None,
+            monodromy_only: false,
         })
     }
 
     /// The piece the scaled state `x̃` is in, laws evaluated at angle `theta`.
-    fn piece(&mut self, theta: f64) -> Piece {
+    pub(super) fn piece(&mut self, theta: f64) -> Piece {
         let n = self.n;
         let mut coefficients = Vec::with_capacity(self.mw.len());
         let mut key = Vec::with_capacity(3 * self.mw.len());
@@ -188,7 +192,11 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
                 }
                 let (fine, degree) = Core::fine(norm1(&a), &self.forcing, self.delta0);
                 let core = self.cores.core(a, self.delta0, fine, &mut self.work);
-                let s = State::new(core, degree, offset, &self.forcing, self.delta0);
+                let s = if self.monodromy_only {
+                    State::without_load(core, offset)
+                } else {
+                    State::new(core, degree, offset, &self.forcing, self.delta0)
+                };
                 if let Some(link) = &mut self.link {
                     link.send(Message::Generator(s.core.clone()));
                 }

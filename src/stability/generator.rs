@@ -295,6 +295,16 @@ impl State {
         }
     }
 
+    /// The state of `core` for the monodromy matrix alone (an orbit that is not integrated,
+    /// [`Orbit::Harmonic`](super::Orbit::Harmonic)): without the load's part `X_δ₀`.
+    pub(crate) fn without_load(core: Arc<Core>, offset: DVector<f64>) -> Self {
+        Self {
+            core,
+            x0: DMatrix::zeros(0, 0),
+            offset,
+        }
+    }
+
     /// `E_δ₀`.
     pub(crate) fn e0(&self) -> &DMatrix<f64> {
         &self.core.e0

@@ -74,6 +74,7 @@ pub(crate) mod expm;
 mod exponential;
 mod flow;
 mod generator;
+mod harmonic_orbit;
 mod integration;
 mod kept;
 mod kernels;
@@ -81,6 +82,7 @@ mod kinks;
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
+mod orbit_check;
 mod pieces;
 mod pipeline;
 mod propagator;
@@ -148,12 +150,33 @@ pub struct Floquet {
     /// for the dense monodromy matrix in the model's DOFs.
     #[serde(default)]
     pub reduction: Option<Reduction>,
+    /// The orbit the multipliers belong to ([`FloquetOptions::orbit`]; the exact orbit where
+    /// the HB orbit's pieces do not apply or the stability decision is too close to call).
+    #[serde(default)]
+    pub orbit: Orbit,
+    /// For the HB orbit's multipliers: their [distance](Floquet::distance) to the exact
+    /// orbit's, the larger of the last two measurements of a sweep (at its first point, every
+    /// [`ORBIT_CHECK_EVERY`]-th and where the multipliers have moved by 0.2 since the last;
+    /// a single analysis measures its own); `None` for the exact orbit.
+    #[serde(default)]
+    pub orbit_difference: Option<f64>,
 }
+
+/// How often a sweep measures the HB orbit's multipliers against the exact orbit's
+/// ([`Orbit::Harmonic`]): at its first analysis and then at every this-many-th.
+pub const ORBIT_CHECK_EVERY: usize = 32;
 
 impl Floquet {
     /// Largest modulus.
     pub fn max_abs(&self) -> f64 {
         self.multipliers.first().map_or(0.0, |m| m.norm())
+    }
+
+    /// How far the leading multipliers of `self` lie from those of `other`: the largest
+    /// distance of a multiplier of either (modulus at least half the largest of both, at
+    /// most 8 of each) to the nearest of the other.
+    pub fn distance(&self, other: &Floquet) -> f64 {
+        shooting::distance(&self.multipliers, &other.multipliers)
     }
 
     /// `true` if every multiplier lies inside the unit circle: `max |μ| <= 1 +`
@@ -210,6 +233,26 @@ pub struct FloquetOptions {
     pub estimate: bool,
     /// How the flow over a period is integrated. Default [`Integrator::Auto`].
     pub integrator: Integrator,
+    /// Which orbit the monodromy matrix follows. Default [`Orbit::Exact`].
+    pub orbit: Orbit,
+}
+
+/// The orbit whose monodromy matrix gives the multipliers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Orbit {
+    /// The exact periodic orbit next to the HB solution, found by shooting: the orbit is
+    /// integrated (sub-steps of the fastest motion, every kink crossing located) and
+    /// corrected by Newton ([`Floquet::polished`]).
+    #[default]
+    Exact,
+    /// The HB orbit itself, where the exponential flow applies: its kink crossings are the
+    /// roots of the harmonics' element coordinates, and `Φ` is the product of the pieces'
+    /// exponentials between them; no orbit is integrated, nothing is polished. The
+    /// multipliers are those of the linearisation along the HB solution, as in Hill's method,
+    /// accurate to about the HB solution's own error ([`Floquet::orbit_correction`] is then
+    /// 0: nothing measured it). Other laws fall back on [`Orbit::Exact`].
+    Harmonic,
 }
 
 /// The integrator of the orbit and its monodromy matrix over a period.
@@ -235,6 +278,7 @@ impl Default for FloquetOptions {
             cutoff: 3.0,
             estimate: true,
             integrator: Integrator::Auto,
+            orbit: Orbit::Exact,
         }
     }
 }

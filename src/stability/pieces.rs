@@ -42,6 +42,17 @@ impl Pieces {
         !self.kinks[e].is_empty()
     }
 
+    /// The kinks of element `e`, sorted.
+    pub(crate) fn kinks(&self, e: usize) -> &[f64] {
+        &self.kinks[e]
+    }
+
+    /// Puts element `e` on the piece just above (`above`) or below its kink `kink`.
+    pub(crate) fn place(&mut self, e: usize, kink: f64, above: bool) {
+        let below = self.kinks[e].iter().filter(|&&k| k < kink).count();
+        self.side[e] = below + usize::from(above);
+    }
+
     /// The open interval of `u` of element `e`'s current piece.
     pub(crate) fn interval(&self, e: usize) -> (f64, f64) {
         let k = &self.kinks[e];
@@ -175,12 +186,16 @@ impl Pieces {
     /// kink, the side it is moving to).
     pub(crate) fn init(&mut self, sys: &Coordinates, q: &[f64], v: &[f64]) {
         for ei in 0..sys.weights.len() {
-            let (u, du) = (sys.gather(ei, q), sys.gather(ei, v));
-            self.side[ei] = self.kinks[ei]
-                .iter()
-                .filter(|&&kv| kv < u || (kv == u && du > 0.0))
-                .count();
+            self.init_element(ei, sys.gather(ei, q), sys.gather(ei, v));
         }
+    }
+
+    /// Sets element `e`'s piece from its `(u, u̇)` (on a kink, the side it is moving to).
+    pub(crate) fn init_element(&mut self, e: usize, u: f64, du: f64) {
+        self.side[e] = self.kinks[e]
+            .iter()
+            .filter(|&&kv| kv < u || (kv == u && du > 0.0))
+            .count();
     }
 
     /// The first crossing of element `e` out of its piece inside a step of length `h` along

@@ -3,14 +3,14 @@
 //! (projected onto the coordinates) with Newton–chord steps ([`chord`](super::chord)), then
 //! the multipliers of the final orbit's `Φ` without its neutral block.
 
-use super::chord::{iterate, KeptJacobian, Problem};
+use super::chord::{iterate, KeptJacobian, Outcome, Problem};
 use super::exponential::ExpFlow;
 use super::flow::{Flow, FlowOptions};
 use super::integration::Integration;
 use super::kept::KeptGenerators;
 use super::scales::scales;
 use super::system::Coordinates;
-use super::{affine, eigenvalues, neutral, Floquet, FloquetOptions, Integrator};
+use super::{affine, eigenvalues, neutral, Floquet, FloquetOptions, Integrator, Orbit};
 use crate::error::{Error, Result};
 use crate::solution::Solution;
 use nalgebra::DMatrix;
@@ -145,7 +145,25 @@ pub(crate) fn shoot(
         goal,
     };
     let jacobian = jacobian.and_then(|j| j.in_scales(sys, (scale_q, scale_v)));
-    let outcome = iterate(&problem, &mut flow, &runge_kutta, &mut x0, jacobian)?;
+    let mut harmonic = false;
+    let outcome = match &mut flow {
+        // The HB orbit's own pieces: no integration, nothing to polish.
+        Integration::Exponential { flow, record } if options.orbit == Orbit::Harmonic => {
+            let periods = solution.basis().subharmonic();
+            let fundamental = solution.basis().fundamental();
+            let all = &solution.harmonics()[..(h + 1) * n_model];
+            flow.along_harmonics(all, fundamental, periods, record)?;
+            harmonic = true;
+            Outcome {
+                phi: flow.monodromy(record)?,
+                polished: false,
+                ahead: None,
+                kappa: None,
+                earlier_steps: 0,
+            }
+        }
+        _ => iterate(&problem, &mut flow, &runge_kutta, &mut x0, jacobian)?,
+    };
     *kept = flow.kept_generators();
     let phi = outcome.phi;
     // The exact orbit's start in the model's DOFs, against the HB state there.
@@ -207,6 +225,12 @@ pub(crate) fn shoot(
             orbit_start,
             steps: outcome.earlier_steps + flow.steps(),
             reduction: None,
+            orbit: if harmonic {
+                Orbit::Harmonic
+            } else {
+                Orbit::Exact
+            },
+            orbit_difference: None,
         },
         kappa: outcome.kappa,
         ahead,

@@ -54,6 +54,7 @@ mod report;
 mod scene_export;
 mod stability_at_scale;
 mod stability_exponential;
+mod stability_harmonic_orbit;
 mod stability_time_domain;
 mod stability_worker;
 mod tail_correction;

@@ -1,0 +1,190 @@
+//! The multipliers of the HB orbit itself ([`Orbit::Harmonic`]): against the independent
+//! references of `tests/data/floquet/` they converge with H as the HB solution does; the
+//! difference to the exact orbit's that the analysis measures and reports is the one there is;
+//! a sweep measures it at its first point and every 32nd and reports it with every point;
+//! laws that are not piecewise affine are shot onto the exact orbit.
+
+use crate::common;
+
+use common::floquet::{hausdorff, orbits, reference_multipliers, scene, solve_at};
+use hbal::continuation::Continuation;
+use hbal::force::CubicSpring;
+use hbal::stability::{FloquetOptions, Orbit, ORBIT_CHECK_EVERY};
+use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
+
+fn harmonic() -> FloquetOptions {
+    FloquetOptions {
+        orbit: Orbit::Harmonic,
+        ..FloquetOptions::default()
+    }
+}
+
+/// The backlash chain's reference orbits (contact damping: saltation at every crossing) and the
+/// two-shaft model's (a rectangular mesh stiffness): the HB orbit's multipliers approach the
+/// reference's as H grows, the exact orbit's stay at the reference's, and the reported
+/// difference is the measured one.
+#[test]
+fn the_hb_orbits_multipliers_converge_with_h_to_the_references() {
+    let chain = scene("tests/data/floquet/chain_backlash.toml");
+    let two_shaft = scene("examples/scenes/two_shaft_6000rpm.toml");
+    let mut cases = Vec::new();
+    for orbit in orbits("chain_backlash.json") {
+        cases.push(("chain", &chain.model, orbit));
+    }
+    for orbit in orbits("two_shaft_6000rpm.json") {
+        cases.push(("two-shaft", &two_shaft.model, orbit));
+    }
+    for (label, model, orbit) in &cases {
+        let want = reference_multipliers(orbit);
+        let mut errors = Vec::new();
+        for h in [16, 32, 64, 128] {
+            let sol = solve_at(label, model, orbit, h);
+            let f = harmonic().compute(model, &sol).unwrap();
+            let exact = FloquetOptions::default().compute(model, &sol).unwrap();
+            assert_eq!(f.orbit, Orbit::Harmonic, "{label}");
+            assert!(!f.polished);
+            let e = hausdorff(&f.multipliers, &want);
+            let d = f.distance(&exact);
+            eprintln!(
+                "{label} W = {} H = {h}: HB orbit {e:.2e} from the reference, exact orbit {:.2e}, reported {:.2e}, measured {d:.2e}, stable {} {}",
+                orbit["W"],
+                hausdorff(&exact.multipliers, &want),
+                f.orbit_difference.unwrap(),
+                f.is_stable(),
+                exact.is_stable()
+            );
+            if *label == "two-shaft" {
+                // No kinks: the pieces are the time jumps alone, whatever the orbit.
+                assert!(d < 1e-12 && e < 1e-11, "{label} H {h}: {d:e} {e:e}");
+            } else {
+                // The reported difference is the measured one, and the error there is.
+                assert_eq!(f.orbit_difference, Some(d));
+                let exact_error = hausdorff(&exact.multipliers, &want);
+                assert!(exact_error < 1e-2 * e, "{label} H {h}");
+                assert!((d / e - 1.0).abs() < 0.05, "{label} H {h}: {d:e} {e:e}");
+            }
+            assert_eq!(f.is_stable(), exact.is_stable(), "{label} H {h}");
+            errors.push(e);
+        }
+        if *label == "chain" {
+            // H⁻³: a factor 8 per doubling (at least 5 asserted), 2e-5 or better at H = 128.
+            for w in errors.windows(2) {
+                assert!(w[1] < w[0] / 5.0, "{label}: {errors:?}");
+            }
+            assert!(errors[3] < 3e-5, "{label}: {errors:?}");
+        }
+    }
+}
+
+/// The backlash chain swept through its symmetry-breaking point (a real multiplier through +1
+/// at W = 1.3455): with the HB orbit's stability the branch, every point's stability and the
+/// located branch point are the exact orbit's; the points near the crossing and every 32nd
+/// are the exact orbit's, the others carry the measured difference.
+#[test]
+fn a_sweep_with_the_hb_orbits_stability_finds_the_exact_branch_point() {
+    let chain = scene("tests/data/floquet/chain_backlash.toml");
+    let run = |options: FloquetOptions| {
+        Continuation {
+            stability: Some(options),
+            ..Continuation::default()
+        }
+        .run(
+            &chain.model,
+            chain.basis.with_omega(1.2).unwrap(),
+            1.5,
+            |_| {},
+        )
+        .unwrap()
+    };
+    let exact = run(FloquetOptions::default());
+    let fast = run(harmonic());
+    assert_eq!(exact.points.len(), fast.points.len());
+    let mut measurements = 0;
+    let mut last = None;
+    for (e, f) in exact.points.iter().zip(&fast.points) {
+        assert_eq!(e.omega.to_bits(), f.omega.to_bits());
+        let (fe, ff) = (e.floquet.as_ref().unwrap(), f.floquet.as_ref().unwrap());
+        assert_eq!(fe.orbit, Orbit::Exact);
+        assert_eq!(fe.is_stable(), ff.is_stable(), "W {}", e.omega);
+        assert_eq!(e.bifurcation, f.bifurcation, "W {}", e.omega);
+        match (e.bifurcation_omega, f.bifurcation_omega) {
+            (Some(a), Some(b)) => assert!((a - b).abs() < 1e-9, "{a} {b}"),
+            (a, b) => assert_eq!(a, b),
+        }
+        let reported = match ff.orbit {
+            Orbit::Harmonic => ff.orbit_difference.unwrap(),
+            Orbit::Exact => 0.0,
+        };
+        // Within the reported difference (a measurement at most 0.2 of multiplier movement
+        // away, the larger of the last two), with a factor 2 of room.
+        let d = fe.distance(ff);
+        assert!(
+            d <= 2.0 * reported + 1e-9,
+            "W {}: {d:e} > {reported:e}",
+            e.omega
+        );
+        if last != ff.orbit_difference {
+            measurements += 1;
+            last = ff.orbit_difference;
+        }
+    }
+    let points = fast.points.len();
+    eprintln!("{measurements} measurements on {points} points");
+    let located = exact
+        .points
+        .iter()
+        .filter(|p| p.bifurcation_omega.is_some());
+    assert_eq!(located.count(), 2, "the branch point each way");
+    assert!(measurements >= points / ORBIT_CHECK_EVERY, "{measurements}");
+    assert!(measurements < points / 2, "{measurements} of {points}");
+}
+
+/// A cubic spring is not piecewise affine: the HB orbit's pieces do not apply, and the
+/// analysis is the exact orbit's, to the bit.
+#[test]
+fn laws_that_are_not_piecewise_affine_get_the_exact_orbit() {
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .damping(hbal::nalgebra::DMatrix::from_element(1, 1, 0.02))
+        .element("spring", &[("x", 1.0)], CubicSpring::new(1.0, 1.0))
+        .load("x", 1, 0.1, 0.0)
+        .build()
+        .unwrap();
+    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(0.5, 7).unwrap()).unwrap();
+    let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
+    let fast = harmonic().compute(&model, &sol).unwrap();
+    let exact = FloquetOptions::default().compute(&model, &sol).unwrap();
+    assert_eq!(fast.orbit, Orbit::Exact);
+    assert_eq!(fast.orbit_difference, None);
+    assert!(fast.polished);
+    assert_eq!(fast.multipliers, exact.multipliers);
+}
+
+/// A period-1 orbit written with the harmonics of half the speed (ν = 2): the HB orbit's
+/// pieces over both periods give the squares of the period-1 multipliers.
+#[test]
+fn over_two_periods_the_multipliers_are_squared() {
+    let chain = scene("tests/data/floquet/chain_backlash.toml");
+    let orbit = &orbits("chain_backlash.json")[0];
+    let sol = solve_at("chain", &chain.model, orbit, 32);
+    let n = chain.model.n_dofs();
+    let basis = sol.basis();
+    let mut q = vec![hbal::num_complex::Complex64::default(); (2 * 32 + 1) * n];
+    for k in 0..=32 {
+        for i in 0..n {
+            q[2 * k * n + i] = sol.harmonic(i, k);
+        }
+    }
+    let doubled = HarmonicBasis::new(basis.omega(), 64)
+        .unwrap()
+        .with_subharmonic(2)
+        .unwrap();
+    let names = sol.dof_names().to_vec();
+    let sol2 = hbal::Solution::from_harmonics(doubled, names, q, 0.0).unwrap();
+    let once = harmonic().compute(&chain.model, &sol).unwrap();
+    let twice = harmonic().compute(&chain.model, &sol2).unwrap();
+    assert_eq!(twice.orbit, Orbit::Harmonic);
+    let squared: Vec<_> = once.multipliers.iter().map(|m| m * m).collect();
+    let d = hausdorff(&twice.multipliers, &squared);
+    assert!(d < 1e-10, "{d:e}");
+}
