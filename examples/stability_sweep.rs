@@ -1,6 +1,8 @@
 //! Cost of the Floquet stability in a run-up sweep of a large model: the same continuation
-//! with and without stability, the stability's share per point, and how many shooting periods
-//! a point needed. A Markdown table on stdout.
+//! without stability, with the exact orbit's and with the HB orbit's ([`Orbit::Harmonic`]),
+//! the stability's share per point, how many shooting periods a point needed, and how far the
+//! HB orbit's multipliers are from the exact orbit's at every point. A Markdown table on
+//! stdout.
 //!
 //! `cargo run --release --example stability_sweep [-- SCENE] [--from RPM] [--to RPM]
 //! [--max-step S] [--repeat R]`
@@ -65,14 +67,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (wall_hb, cpu_hb, all_hb, plain) = run(None)?;
     let options = FloquetOptions {
         cutoff: flag(&args, "--cutoff", FloquetOptions::default().cutoff),
-        orbit: if args.iter().any(|a| a == "harmonic") {
-            Orbit::Harmonic
-        } else {
-            Orbit::Exact
-        },
         ..FloquetOptions::default()
     };
+    let harmonic = FloquetOptions {
+        orbit: Orbit::Harmonic,
+        ..options
+    };
     let (wall, cpu, all, branch) = run(Some(options))?;
+    let (wall_h, cpu_h, all_h, fast) = run(Some(harmonic))?;
     let points = branch.points.len();
     if std::env::var("DUMP").is_ok() {
         dump(&branch);
@@ -125,13 +127,48 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cpu_hb,
         plain.points.len(),
     );
-    row("continuation with stability", wall, all, cpu, points);
+    row("with the exact orbit's stability", wall, all, cpu, points);
     row(
-        "stability share (difference)",
+        "with the HB orbit's stability",
+        wall_h,
+        all_h,
+        cpu_h,
+        fast.points.len(),
+    );
+    row(
+        "exact orbit's stability share (difference)",
         wall - wall_hb,
         all - all_hb,
         cpu - cpu_hb,
         points,
+    );
+    row(
+        "HB orbit's stability share (difference)",
+        wall_h - wall_hb,
+        all_h - all_hb,
+        cpu_h - cpu_hb,
+        points,
+    );
+    // The HB orbit's multipliers against the exact orbit's at every point, and what the
+    // points reported.
+    let (mut worst, mut reported, mut on_hb) = (0.0_f64, 0.0_f64, 0);
+    for (e, f) in branch.points.iter().zip(&fast.points) {
+        if let (Some(e), Some(f)) = (&e.floquet, &f.floquet) {
+            worst = worst.max(e.distance(f));
+            reported = reported.max(f.orbit_difference.unwrap_or(0.0));
+            on_hb += usize::from(f.orbit == Orbit::Harmonic);
+        }
+    }
+    println!(
+        "
+HB orbit's multipliers at {on_hb} of {} points: at most {worst:.1e} from the exact orbit's at any point (reported: at most {reported:.1e}); the largest |μ| within {:.1e}",
+        fast.points.len(),
+        branch
+            .points
+            .iter()
+            .zip(&fast.points)
+            .filter_map(|(e, f)| Some((e.floquet.as_ref()?.max_abs() - f.floquet.as_ref()?.max_abs()).abs()))
+            .fold(0.0, f64::max)
     );
     if let Some(r) = branch
         .points

@@ -188,3 +188,78 @@ fn over_two_periods_the_multipliers_are_squared() {
     let d = hausdorff(&twice.multipliers, &squared);
     assert!(d < 1e-10, "{d:e}");
 }
+
+/// `hbal sweep --stability-orbit harmonic` on the backlash chain through its branch point:
+/// every point says whose multipliers it has and, for the HB orbit's, the measured difference;
+/// the branch point lies where the exact orbit's sweep has it; bad combinations exit 2.
+#[test]
+fn the_cli_reports_whose_multipliers_a_point_has() {
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/scenes/chain_backlash.toml");
+    let scene = scene.to_str().unwrap();
+    let sweep = |extra: &[&str]| {
+        let mut args = vec![
+            "sweep",
+            scene,
+            "--from",
+            "1.3",
+            "--to",
+            "1.4",
+            "--no-error-estimate",
+        ];
+        args.extend_from_slice(extra);
+        common::hbal(&args)
+    };
+    let run = |extra: &[&str]| -> serde_json::Value {
+        let out = sweep(extra);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let fast = run(&["--stability-orbit", "harmonic", "--json"]);
+    let exact = run(&["--json"]);
+    let located = |doc: &serde_json::Value| -> Vec<f64> {
+        let points = doc["points"].as_array().unwrap();
+        points
+            .iter()
+            .filter_map(|p| p["bifurcation_speed"].as_f64())
+            .collect()
+    };
+    let (a, b) = (located(&fast), located(&exact));
+    assert_eq!(a.len(), 1, "{a:?}");
+    assert!((a[0] - b[0]).abs() < 1e-9, "{a:?} {b:?}");
+    for p in fast["points"].as_array().unwrap() {
+        match p["stability_orbit"].as_str().unwrap() {
+            "harmonic" => assert!(p["orbit_difference"].as_f64().unwrap() > 0.0),
+            "exact" => assert!(p["orbit_difference"].is_null()),
+            other => panic!("{other}"),
+        }
+    }
+    for p in exact["points"].as_array().unwrap() {
+        assert_eq!(p["stability_orbit"], "exact");
+        assert!(p["orbit_difference"].is_null());
+    }
+    let text = sweep(&["--stability-orbit", "harmonic"]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("stability of the HB orbit at "), "{text}");
+    for bad in [
+        &["--stability-orbit", "harmonic", "--no-stability"][..],
+        &[
+            "--stability-orbit",
+            "harmonic",
+            "--parameter",
+            "loads[0].cos",
+        ][..],
+        &["--stability-orbit", "hb"][..],
+    ] {
+        let out = sweep(bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("stability-orbit"),
+            "{bad:?}"
+        );
+    }
+}
