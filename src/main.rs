@@ -184,7 +184,6 @@ enum Command {
 /// Largest number of points of a sweep (`--max-points`, `--points`): bounds its time.
 const MAX_SWEEP_POINTS: u64 = 100_000;
 
-/// A point count from `min` to [`MAX_SWEEP_POINTS`].
 /// `exact` or `harmonic`.
 fn parse_orbit(s: &str) -> Result<hbal::stability::Orbit, String> {
     match s {
@@ -194,6 +193,7 @@ fn parse_orbit(s: &str) -> Result<hbal::stability::Orbit, String> {
     }
 }
 
+/// A point count from `min` to [`MAX_SWEEP_POINTS`].
 fn sweep_points(min: u64) -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::new().range(min..=MAX_SWEEP_POINTS)
 }

@@ -88,6 +88,11 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 file.display()
             );
         }
+        if opts.orbit == hbal::stability::Orbit::Harmonic {
+            eprintln!(
+                "note: --stability-orbit harmonic is not used: the exact piecewise solution's multipliers are its exact orbit's"
+            );
+        }
     }
     // Default start speed: the start file's, else the scene's.
     let from = opts.from.unwrap_or_else(|| {

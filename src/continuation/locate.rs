@@ -53,7 +53,12 @@ impl Continuation {
         b: &super::BranchPoint,
         kind: Bifurcation,
     ) -> Result<Option<(Vec<Complex64>, f64)>> {
-        let options = self.stability.unwrap_or_default();
+        // Every trial on the exact orbit (a single analysis of the HB orbit's would measure
+        // it against the exact orbit's anyway).
+        let options = crate::stability::FloquetOptions {
+            orbit: crate::stability::Orbit::Exact,
+            ..self.stability.unwrap_or_default()
+        };
         let (Some(fa), Some(fb)) = (
             a.floquet.as_ref().and_then(|f| critical_value(f, kind)),
             b.floquet.as_ref().and_then(|f| critical_value(f, kind)),

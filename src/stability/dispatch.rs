@@ -57,7 +57,9 @@ pub struct Reduction {
     /// multipliers `μ_i` (modulus at least half the largest, at most 8) to those `μ'_j` on the
     /// basis with twice the cut-off (more if that adds no mode). `Some(0)` when the basis
     /// spans the whole space (a similarity transform: only the integrator's error is left);
-    /// `None` when not estimated ([`FloquetOptions::estimate`]).
+    /// `None` when not estimated ([`FloquetOptions::estimate`]). For the HB orbit's
+    /// multipliers ([`Orbit::Harmonic`]) the distance to the exact orbit's on the wider
+    /// basis: the orbit's error and the basis's together.
     #[serde(default)]
     pub estimate: Option<f64>,
     /// Size of the comparison basis of the estimate.
@@ -288,19 +290,27 @@ impl FloquetOptions {
             larger = reduced_basis(model, wider, wider, &mut cache.modes)?;
         }
         info.comparison_dofs = Some(larger.v.ncols());
+        // The exact orbits on both bases, also for the HB orbit's multipliers: the HB orbit's
+        // pieces do not depend on the basis, so its multipliers on both would hide what the
+        // basis does to the orbit (their difference to the exact orbit's on this basis is
+        // `orbit_difference`).
+        let exact = FloquetOptions {
+            orbit: Orbit::Exact,
+            ..*self
+        };
         let goal = match cache.kappa {
-            Some(kappa) => Goal::Compare {
+            Some(kappa) if floquet.orbit == Orbit::Exact => Goal::Compare {
                 reference: &floquet.multipliers,
                 kappa,
             },
-            None => Goal::Exact,
+            _ => Goal::Exact,
         };
         let sys = Coordinates::reduced(model, larger.v);
         let start = Start::State(&floquet.orbit_start);
         let reference = shoot(
             &sys,
             solution,
-            self,
+            &exact,
             start,
             goal,
             None,
@@ -332,6 +342,9 @@ pub struct FloquetCache {
     last_time: Option<std::time::Duration>,
     /// The last measurement of the HB orbit's multipliers against the exact orbit's.
     pub(super) orbit_check: Option<OrbitCheck>,
+    /// The HB orbit's pieces did not apply (laws that are not piecewise affine): the next
+    /// points go to the exact orbit directly.
+    pub(super) exact_only: bool,
 }
 
 /// Orbit corrections kept for the next point's prediction (a quadratic in Ω).

@@ -69,7 +69,7 @@ pub(crate) struct ExpFlow<'c, 'm> {
     pub(super) states: Vec<State>,
     /// Their cores, kept from the last analysis or formed here.
     cores: Cores,
-    index: WordMap<Vec<u64>, usize>,
+    pub(super) index: WordMap<Vec<u64>, usize>,
     /// The Taylor series of the exact solution from the last expansion point.
     pub(super) taylor: Expansion,
     /// The elements with kinks.
@@ -87,7 +87,7 @@ pub(crate) struct ExpFlow<'c, 'm> {
 /// A piece: its generator and the laws' coefficients `(f0_e, k_e, d_e)`.
 pub(super) struct Piece {
     pub(super) state: usize,
-    coefficients: Vec<(f64, f64, f64)>,
+    pub(super) coefficients: Vec<(f64, f64, f64)>,
 }
 
 impl<'c, 'm> ExpFlow<'c, 'm> {
@@ -221,12 +221,23 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
 
     /// `true` if every law at `x̃` and `theta` still has the piece's coefficients.
     fn still_affine(&self, piece: &Piece, x: &DVector<f64>, theta: f64) -> bool {
+        self.coefficients_hold(piece, theta, |e| self.element_state(e, x))
+    }
+
+    /// `true` if every law `e` at `theta` and `state(e) = (u, u̇)` has the piece's
+    /// coefficients (to 1e-9).
+    pub(super) fn coefficients_hold(
+        &self,
+        piece: &Piece,
+        theta: f64,
+        state: impl Fn(usize) -> (f64, f64),
+    ) -> bool {
         piece
             .coefficients
             .iter()
             .enumerate()
             .all(|(e, &(f0, k, d))| {
-                let (u, du) = self.element_state(e, x);
+                let (u, du) = state(e);
                 let (f, k1, d1) = self.pieces.law(self.sys, e, theta, u, du);
                 let close = |a: f64, b: f64, size: f64| (a - b).abs() <= 1e-9 * size;
                 close(k, k1, k.abs().max(k1.abs()))

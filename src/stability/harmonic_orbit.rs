@@ -23,6 +23,7 @@ use super::exponential::ExpFlow;
 use super::record::Step;
 use crate::error::{Error, Result};
 use crate::harmonic::{AftPlan, HarmonicBasis};
+use crate::model::Model;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 
@@ -42,31 +43,39 @@ impl ExpFlow<'_, '_> {
     /// Appends to `record` the pieces of the HB orbit with harmonics `harmonics` (the model's
     /// DOFs, harmonic-major, `0..=H`) and fundamental `fundamental` over its period (`periods`
     /// periods of the flow's Ω). The element coordinates are the model's, not their projection
-    /// onto a reduced basis: the pieces are the HB solution's, whatever the basis.
+    /// onto a reduced basis: the pieces are the HB solution's, whatever the basis. At the
+    /// end of every piece each law is evaluated at the HB orbit: `Ok(false)` if one is not
+    /// affine on its piece after all (as the integrated flow checks), and `record` is then
+    /// meaningless.
     pub(crate) fn along_harmonics(
         &mut self,
         harmonics: &[Complex64],
         fundamental: f64,
         periods: usize,
         record: &mut Vec<Step>,
-    ) -> Result<()> {
+    ) -> Result<bool> {
         self.monodromy_only = true;
         record.clear();
         self.begin_pass();
         let crossings = self.crossings(harmonics, fundamental)?;
+        let coordinates = element_harmonics(self.sys.model, harmonics);
         let (omega, delta0) = (self.omega, self.delta0);
         let bounds = self.bounds.clone();
         let mut next = crossings.iter().peekable();
+        let windows = bounds.len() - 1;
         for p in 0..periods {
             let offset = p as f64 * TAU / omega;
-            for w in bounds.windows(2) {
+            for (i, w) in bounds.windows(2).enumerate() {
                 let (ta, tb) = (offset + w[0] / omega, offset + w[1] / omega);
+                // The last window takes every event left: a root within rounding of 2π may
+                // map to a time at or past its end.
+                let last = p + 1 == periods && i + 1 == windows;
                 let margin = 1e-9 * (w[1] - w[0]);
                 let angle = |t: f64| (w[0] + omega * (t - ta)).clamp(w[0] + margin, w[1] - margin);
                 let mut t = ta;
                 loop {
-                    let event = next.next_if(|c| c.theta / fundamental < tb);
-                    let end = event.map_or(tb, |c| (c.theta / fundamental).max(t));
+                    let event = next.next_if(|c| last || c.theta / fundamental < tb);
+                    let end = event.map_or(tb, |c| (c.theta / fundamental).clamp(t, tb));
                     if end > t {
                         let piece = self.piece(angle(0.5 * (t + end)));
                         let whole = ((end - t) / delta0).floor();
@@ -78,6 +87,14 @@ impl ExpFlow<'_, '_> {
                             tau,
                         };
                         self.emit(record, step);
+                        let theta = (end * fundamental).rem_euclid(TAU);
+                        let hb = |e: usize| {
+                            let (u, slope) = value_and_slope(&coordinates[e], theta);
+                            (u, slope * fundamental)
+                        };
+                        if !self.coefficients_hold(&piece, angle(end), hb) {
+                            return Ok(false);
+                        }
                     }
                     t = end;
                     let Some(c) = event else { break };
@@ -104,7 +121,15 @@ impl ExpFlow<'_, '_> {
             }
         }
         self.end_pass();
-        Ok(())
+        Ok(true)
+    }
+
+    /// Back to integrating orbits after [`ExpFlow::along_harmonics`] gave up: the generators'
+    /// states without the load's part are dropped (their cores stay kept).
+    pub(crate) fn integrate_from_here(&mut self) {
+        self.monodromy_only = false;
+        self.states.clear();
+        self.index.clear();
     }
 
     /// Every kink crossing of the HB orbit over its period, in time order; each kinked
@@ -156,22 +181,49 @@ impl ExpFlow<'_, '_> {
     }
 }
 
+/// `(u(θ), u'(θ))` of `u = Re Σ_k U_k e^{ikθ}`.
+fn value_and_slope(u: &[Complex64], theta: f64) -> (f64, f64) {
+    let (mut v, mut d) = (0.0, 0.0);
+    let rot = Complex64::from_polar(1.0, theta);
+    let mut z = Complex64::new(1.0, 0.0);
+    for (k, uk) in u.iter().enumerate() {
+        if k > 0 {
+            z *= rot;
+        }
+        let c = uk * z;
+        v += c.re;
+        d -= k as f64 * c.im;
+    }
+    (v, d)
+}
+
+/// The harmonics `U_e,k = w_e·Q_k` of every element's coordinate (`harmonics` in the model's
+/// DOFs, harmonic-major).
+fn element_harmonics(model: &Model, harmonics: &[Complex64]) -> Vec<Vec<Complex64>> {
+    let n = model.n_dofs();
+    let h = harmonics.len() / n.max(1);
+    model
+        .elements()
+        .iter()
+        .map(|e| {
+            (0..h)
+                .map(|k| {
+                    e.weights()
+                        .iter()
+                        .map(|&(i, w)| harmonics[k * n + i] * w)
+                        .sum()
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// The root of `u(θ) − κ` (`u = Re Σ_k U_k e^{ikθ}`) in `[θ₀, θ₀ + δ]`, where it goes from `a`
 /// to `b` (opposite signs): safeguarded Newton from the secant's root, bisection where a step
 /// leaves the bracket. `(θ*, u'(θ*))`, `θ*` in `[0, 2π)`.
 fn root(u: &[Complex64], kink: f64, theta0: f64, delta: f64, a: f64, b: f64) -> (f64, f64) {
     let eval = |t: f64| {
-        let (mut v, mut d) = (0.0, 0.0);
-        let rot = Complex64::from_polar(1.0, t);
-        let mut z = Complex64::new(1.0, 0.0);
-        for (k, uk) in u.iter().enumerate() {
-            if k > 0 {
-                z *= rot;
-            }
-            let c = uk * z;
-            v += c.re;
-            d -= k as f64 * c.im;
-        }
+        let (v, d) = value_and_slope(u, t);
         (v - kink, d)
     };
     let (mut lo, mut hi) = (theta0, theta0 + delta);

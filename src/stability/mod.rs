@@ -155,7 +155,8 @@ pub struct Floquet {
     #[serde(default)]
     pub orbit: Orbit,
     /// For the HB orbit's multipliers: their [distance](Floquet::distance) to the exact
-    /// orbit's, the larger of the last two measurements of a sweep (at its first point, every
+    /// orbit's on the same coordinates (on a reduced basis, what the basis does to the exact
+    /// orbit is in [`Reduction::estimate`]), the larger of the last two measurements of a sweep (at its first point, every
     /// [`ORBIT_CHECK_EVERY`]-th and where the multipliers have moved by 0.2 since the last;
     /// a single analysis measures its own); `None` for the exact orbit.
     #[serde(default)]
@@ -250,8 +251,10 @@ pub enum Orbit {
     /// roots of the harmonics' element coordinates, and `Φ` is the product of the pieces'
     /// exponentials between them; no orbit is integrated, nothing is polished. The
     /// multipliers are those of the linearisation along the HB solution, as in Hill's method,
-    /// accurate to about the HB solution's own error ([`Floquet::orbit_correction`] is then
-    /// 0: nothing measured it). Other laws fall back on [`Orbit::Exact`].
+    /// accurate to about the HB solution's own error: [`Floquet::orbit_difference`] says how
+    /// far from the exact orbit's on the same coordinates, as measured ([`Floquet::orbit_correction`]
+    /// is 0: no shooting moved the orbit). Other laws, and [`Integrator::RungeKutta`], fall
+    /// back on [`Orbit::Exact`].
     Harmonic,
 }
 

@@ -145,24 +145,31 @@ pub(crate) fn shoot(
         goal,
     };
     let jacobian = jacobian.and_then(|j| j.in_scales(sys, (scale_q, scale_v)));
-    let mut harmonic = false;
-    let outcome = match &mut flow {
-        // The HB orbit's own pieces: no integration, nothing to polish.
+    // The HB orbit's own pieces: no integration, nothing to polish (unless a law turns out
+    // not to be affine along it).
+    let along = match &mut flow {
         Integration::Exponential { flow, record } if options.orbit == Orbit::Harmonic => {
-            let periods = solution.basis().subharmonic();
-            let fundamental = solution.basis().fundamental();
             let all = &solution.harmonics()[..(h + 1) * n_model];
-            flow.along_harmonics(all, fundamental, periods, record)?;
-            harmonic = true;
-            Outcome {
-                phi: flow.monodromy(record)?,
-                polished: false,
-                ahead: None,
-                kappa: None,
-                earlier_steps: 0,
+            let basis = solution.basis();
+            if flow.along_harmonics(all, basis.fundamental(), basis.subharmonic(), record)? {
+                Some(flow.monodromy(record)?)
+            } else {
+                flow.integrate_from_here();
+                None
             }
         }
-        _ => iterate(&problem, &mut flow, &runge_kutta, &mut x0, jacobian)?,
+        _ => None,
+    };
+    let harmonic = along.is_some();
+    let outcome = match along {
+        Some(phi) => Outcome {
+            phi,
+            polished: false,
+            ahead: None,
+            kappa: None,
+            earlier_steps: 0,
+        },
+        None => iterate(&problem, &mut flow, &runge_kutta, &mut x0, jacobian)?,
     };
     *kept = flow.kept_generators();
     let phi = outcome.phi;
