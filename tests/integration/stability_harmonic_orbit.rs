@@ -269,6 +269,7 @@ fn the_cli_reports_whose_multipliers_a_point_has() {
 /// multipliers compares them with the exact orbit's on the wider basis, so with the orbit's
 /// measured difference it covers the distance to the dense exact orbit's.
 #[test]
+#[ignore = "heavy in a debug build (dense 100-DOF analyses, 14 s): CI runs it in release"]
 fn on_a_reduced_basis_the_estimate_covers_the_orbit_and_the_basis() {
     use hbal::stability::FloquetMethod;
     for rpm in [1200.0, 2000.0, 3000.0] {
