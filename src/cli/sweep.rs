@@ -275,6 +275,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         );
         if let Some(line) = super::sweep_summary::orbit_line(&branch) {
             say!("  {line}");
+        } else if let Some(hint) = super::sweep_summary::orbit_hint(&branch) {
+            say!("  {hint}");
         }
         if let Some(e) = scene.model.memory_element().filter(|_| opts.stability) {
             say!(
