@@ -45,32 +45,26 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
     for (i, &p) in values.iter().enumerate() {
         let (model, basis) = match build(p) {
             Ok(v) => v,
-            Err(e) => match branch.as_mut() {
-                // Keep the points so far.
-                Some(b) => {
-                    b.stop = BranchStop::InvalidParameter {
-                        parameter: p,
-                        reason: e.to_string(),
-                    };
-                    break;
-                }
-                None => return Err(e),
-            },
+            // Keep the points so far.
+            Err(e) => {
+                end_here(&mut branch, e, |reason| BranchStop::InvalidParameter {
+                    parameter: p,
+                    reason,
+                })?;
+                break;
+            }
         };
         let model: &Model = model.borrow();
         let mut hb = match HarmonicBalance::with_formulation(model, basis, formulation) {
             Ok(hb) => hb,
             // After the first point, a numerical failure ends the branch and keeps its points.
-            Err(e) => match branch.as_mut() {
-                Some(b) => {
-                    b.stop = BranchStop::Failed {
-                        parameter: p,
-                        reason: e.to_string(),
-                    };
-                    break;
-                }
-                None => return Err(e),
-            },
+            Err(e) => {
+                end_here(&mut branch, e, |reason| BranchStop::Failed {
+                    parameter: p,
+                    reason,
+                })?;
+                break;
+            }
         };
         crate::solve::check_dense_for_continuation(&hb)?;
         let mut ws = hb.workspace();
@@ -85,16 +79,13 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
                     exact = Some(e);
                     sol
                 }
-                Err(e) => match branch.as_mut() {
-                    Some(b) => {
-                        b.stop = BranchStop::Failed {
-                            parameter: p,
-                            reason: e.to_string(),
-                        };
-                        break;
-                    }
-                    None => return Err(e),
-                },
+                Err(e) => {
+                    end_here(&mut branch, e, |reason| BranchStop::Failed {
+                        parameter: p,
+                        reason,
+                    })?;
+                    break;
+                }
             },
             (_, Some(q)) if q.len() == full => {
                 match Newton::new()
@@ -159,4 +150,20 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
         progress((i + 1) as f64 / values.len() as f64);
     }
     branch.ok_or_else(|| Error::invalid("parameter sweep", "values", 0.0, "at least one value"))
+}
+
+/// Ends `branch` with the stop `stop(reason of e)` if it has points; `e` itself before the
+/// first point.
+fn end_here(
+    branch: &mut Option<Branch>,
+    e: crate::error::Error,
+    stop: impl FnOnce(String) -> BranchStop,
+) -> Result<()> {
+    match branch.as_mut() {
+        Some(b) => {
+            b.stop = stop(e.to_string());
+            Ok(())
+        }
+        None => Err(e),
+    }
 }

@@ -7,8 +7,8 @@
 use crate::common;
 
 use common::floquet::{hausdorff, orbits, reference_multipliers, scene, solve_at};
+use hbal::catalog::Duffing;
 use hbal::continuation::Continuation;
-use hbal::force::CubicSpring;
 use hbal::stability::{FloquetOptions, Orbit, ORBIT_CHECK_EVERY};
 use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
 
@@ -143,13 +143,7 @@ fn a_sweep_with_the_hb_orbits_stability_finds_the_exact_branch_point() {
 /// analysis is the exact orbit's, to the bit.
 #[test]
 fn laws_that_are_not_piecewise_affine_get_the_exact_orbit() {
-    let model = Model::builder(&["x"])
-        .mass_diagonal(&[1.0])
-        .damping(hbal::nalgebra::DMatrix::from_element(1, 1, 0.02))
-        .element("spring", &[("x", 1.0)], CubicSpring::new(1.0, 1.0))
-        .load("x", 1, 0.1, 0.0)
-        .build()
-        .unwrap();
+    let model = Duffing::default().model().unwrap();
     let hb = HarmonicBalance::new(&model, HarmonicBasis::new(0.5, 7).unwrap()).unwrap();
     let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
     let fast = harmonic().compute(&model, &sol).unwrap();
