@@ -48,8 +48,10 @@ use crate::force::ForceLaw;
 use crate::harmonic::{AftPlan, AftScratch, HarmonicBasis};
 use crate::linear::envelope::Envelope;
 use crate::model::Model;
+use element::TailElement;
 use num_complex::Complex64;
-use std::sync::Arc;
+
+mod element;
 
 /// Whether the tail correction applies to `law`: linear in the state, without memory, with
 /// coefficients that jump in time.
@@ -62,8 +64,8 @@ pub(crate) fn corrects(law: &dyn ForceLaw) -> bool {
 pub(super) struct TailCorrection {
     /// The fine grid: L harmonics on `N_T` samples.
     plan: AftPlan,
-    /// The shaft angles of the fine grid, what the laws see.
-    thetas: Vec<f64>,
+    /// `N_T`, the fine grid's samples.
+    samples: usize,
     elements: Vec<TailElement>,
     /// `C = Wᵀ M⁻¹ W` over the jumping elements, row-major.
     mobility: Vec<f64>,
@@ -75,14 +77,9 @@ pub(super) struct TailCorrection {
     /// mass-dominated (`|R| ≤ 0.3 |C/s_H²|`), 0 where they are not (`≥ 0.5`), linear between,
     /// so that the residual does not jump with Ω.
     weight: f64,
-}
-
-/// A jumping element: its index among the active elements and its law band-limited to
-/// `L + H` orders on the fine grid.
-#[derive(Debug)]
-struct TailElement {
-    active: usize,
-    law: Arc<dyn ForceLaw>,
+    /// `weight · G_l[b, a]` at `l = H+1..=L`, harmonic-major (`(l − H − 1) m² + b m + a`),
+    /// from the model below at the current Ω.
+    weighted_receptance: Vec<Complex64>,
 }
 
 /// Buffers of the tail correction (empty without one).
@@ -92,7 +89,6 @@ pub struct TailBuffers {
     uk: Vec<Complex64>,
     u: Vec<f64>,
     du: Vec<f64>,
-    f: Vec<f64>,
     /// The force harmonics `0..=L` of every jumping element, element-major.
     spectra: Vec<Complex64>,
     vk: Vec<Complex64>,
@@ -120,6 +116,7 @@ impl TailCorrection {
             .with_subharmonic(nu)?;
         // Coefficient orders up to (L + H)/ν of the shaft: ν·band ≤ N_T/2 − 1, alias-free.
         let band = (top + h) / nu;
+        let thetas: Vec<f64> = (0..samples).map(|j| fine.shaft_angle(j)).collect();
         let elements: Vec<TailElement> = hb
             .active
             .iter()
@@ -129,8 +126,8 @@ impl TailCorrection {
                 if !corrects(law) {
                     return None;
                 }
-                let law: Arc<dyn ForceLaw> = law.band_limited(samples, band)?.into();
-                Some(TailElement { active: i, law })
+                let law = law.band_limited(samples, band)?;
+                Some(TailElement::new(i, law.as_ref(), &thetas))
             })
             .collect();
         if elements.is_empty() {
@@ -141,13 +138,14 @@ impl TailCorrection {
             return Ok(None);
         };
         let mut tail = Self {
-            thetas: (0..samples).map(|j| fine.shaft_angle(j)).collect(),
+            samples,
             plan: AftPlan::new(fine),
             mass_h: vec![0.0; mobility.len()],
             rest_h: vec![Complex64::default(); mobility.len()],
             mobility,
             elements,
             weight: 0.0,
+            weighted_receptance: Vec::new(),
         };
         tail.fit(hb);
         Ok(Some(tail))
@@ -188,6 +186,14 @@ impl TailCorrection {
         } else {
             0.0
         };
+        let (top, m2) = (self.plan.basis().harmonics(), m * m);
+        let table = (h + 1..=top).flat_map(|l| {
+            let r = h as f64 / l as f64;
+            (0..m2).map(move |i| (i, r))
+        });
+        self.weighted_receptance = table
+            .map(|(i, r)| self.receptance(i, r) * self.weight)
+            .collect();
     }
 
     /// Whether the correction is applied at the current Ω (with a positive weight).
@@ -214,7 +220,6 @@ impl TailCorrection {
             uk: vec![Complex64::default(); top + 1],
             u: vec![0.0; samples],
             du: vec![0.0; samples],
-            f: vec![0.0; samples],
             spectra: vec![Complex64::default(); self.elements.len() * (top + 1)],
             vk: vec![Complex64::default(); top + 1],
         }
@@ -235,9 +240,8 @@ impl TailCorrection {
                 super::aft::scatter_add(weights, *f, &mut out[k * n..(k + 1) * n]);
             }
         });
-        let m = self.elements.len();
-        ws.ffts += 6 * m;
-        ws.force_evaluations += 2 * m * self.thetas.len();
+        ws.ffts += 2 * self.elements.iter().map(|e| e.ffts()).sum::<usize>();
+        ws.force_evaluations += 2 * self.elements.len() * self.samples;
     }
 
     /// The force harmonics `0..=H` the tail adds to every jumping element, `each(index
@@ -256,7 +260,6 @@ impl TailCorrection {
         let Some(aft) = tb.aft.as_mut() else {
             return;
         };
-        let velocity = |k: usize| Complex64::new(0.0, k as f64 * omega);
         // The force harmonics above H of every jumping element, from the kept harmonics.
         for (a, te) in self.elements.iter().enumerate() {
             let weights = &hb.active[te.active].weights;
@@ -264,29 +267,25 @@ impl TailCorrection {
             for (k, uk) in tb.uk[..=h].iter_mut().enumerate() {
                 *uk = super::aft::gather(weights, &q[k * n..(k + 1) * n]);
             }
-            self.plan
-                .synthesize_into(&tb.uk, |_| Complex64::new(1.0, 0.0), &mut tb.u, aft);
-            self.plan.synthesize_into(&tb.uk, velocity, &mut tb.du, aft);
-            te.law.force_batch(&self.thetas, &tb.u, &tb.du, &mut tb.f);
             let spectrum = &mut tb.spectra[a * (top + 1)..(a + 1) * (top + 1)];
-            self.plan.analyze_into(&mut tb.f, spectrum, aft);
+            te.force_harmonics(
+                &self.plan, omega, &tb.uk, &mut tb.u, &mut tb.du, spectrum, aft,
+            );
         }
         // The tail of every element's coordinate and its force on the kept harmonics.
         for (b, te) in self.elements.iter().enumerate() {
             tb.uk.fill(Complex64::default());
-            for l in h + 1..=top {
-                let r = h as f64 / l as f64;
+            let receptances = self.weighted_receptance.chunks_exact(m * m);
+            for (l, g) in (h + 1..=top).zip(receptances) {
                 let mut v = Complex64::default();
-                for a in 0..m {
-                    v -= self.receptance(b * m + a, r) * tb.spectra[a * (top + 1) + l];
+                for (a, g) in g[b * m..(b + 1) * m].iter().enumerate() {
+                    v -= g * tb.spectra[a * (top + 1) + l];
                 }
-                tb.uk[l] = v * self.weight;
+                tb.uk[l] = v;
             }
-            self.plan
-                .synthesize_into(&tb.uk, |_| Complex64::new(1.0, 0.0), &mut tb.u, aft);
-            self.plan.synthesize_into(&tb.uk, velocity, &mut tb.du, aft);
-            te.law.force_batch(&self.thetas, &tb.u, &tb.du, &mut tb.f);
-            self.plan.analyze_into(&mut tb.f, &mut tb.vk, aft);
+            te.force_harmonics(
+                &self.plan, omega, &tb.uk, &mut tb.u, &mut tb.du, &mut tb.vk, aft,
+            );
             each(te.active, &tb.vk);
         }
     }
