@@ -44,8 +44,10 @@ static GLOBAL: Counting = Counting;
 fn fixed_point_iterations_do_not_allocate() {
     let case = TwoShaft::new(60000.0);
     let model = case.model().unwrap();
-    let hb =
-        HarmonicBalance::new(&model, HarmonicBasis::new(case.mesh_omega(), 32).unwrap()).unwrap();
+    let basis = HarmonicBasis::new(case.mesh_omega(), 32)
+        .unwrap()
+        .with_tail_correction(true);
+    let hb = HarmonicBalance::new(&model, basis).unwrap();
     let mut ws = hb.workspace();
     let count = |iterations: usize, ws: &mut hbal::Workspace| {
         let solver = FixedPoint::new()

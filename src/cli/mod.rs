@@ -34,6 +34,7 @@ pub(crate) mod report_html;
 pub(crate) mod solve;
 pub(crate) mod solve_exact;
 mod solve_files;
+mod solve_hints;
 pub(crate) mod start;
 pub(crate) mod sweep;
 pub(crate) mod sweep_summary;
@@ -207,14 +208,14 @@ pub(crate) fn auto_with(auto: &mut Option<hbal::solve::AutoHarmonics>, args: &So
     }
 }
 
-/// The basis of `H` and `N` of `chosen` (automatic harmonics at another speed or parameter)
-/// at the speed and with the tail correction of `basis`.
+/// The basis of `H`, `N` and tail correction of `chosen` (automatic harmonics at another
+/// speed or parameter) at the speed of `basis`.
 pub(crate) fn basis_like(
     basis: &HarmonicBasis,
     chosen: &HarmonicBasis,
 ) -> hbal::Result<HarmonicBasis> {
     HarmonicBasis::new(basis.omega(), chosen.harmonics())?
-        .with_tail_correction(basis.tail_correction())
+        .with_tail_correction_of(chosen)
         .with_samples(chosen.samples())
 }
 
@@ -228,7 +229,7 @@ pub(crate) fn basis_with(
     if let Some(HarmonicsArg::Count(h)) = args.harmonics {
         let b = HarmonicBasis::new(basis.omega(), h)
             .with_context(|| format!("{file}: --harmonics"))?
-            .with_tail_correction(basis.tail_correction());
+            .with_tail_correction_of(basis);
         // Keep the scene's N where it can still carry H harmonics.
         out = b.with_samples(basis.samples()).unwrap_or(b);
     }

@@ -2,9 +2,9 @@
 //! `--start` file, compute the orbit's Floquet stability, print a summary or one JSON object, and
 //! optionally write harmonics.csv, time_series.csv and SVG plots.
 
-use super::solve_exact;
 use super::solve_files::{write_outputs, OutputLabel};
 use super::{element_report, load, multipliers_json, start, Failure, SolverArgs};
+use super::{solve_exact, solve_hints};
 use anyhow::Context;
 use hbal::stability::Floquet;
 use hbal::HarmonicBalance;
@@ -103,10 +103,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             let estimate = sol.is_converged().then(|| {
                 hbal::solve::estimate_error(&scene.model, &sol).map_err(|e| e.to_string())
             });
+            solve_hints::print(&scene, Some(&hb), estimate.as_ref());
             (sol, estimate, None)
         }
     };
-    solve_exact::hint(&scene, estimate.as_ref());
+    if scene.auto.is_some() || exact.is_some() {
+        solve_hints::print(&scene, None, estimate.as_ref());
+    }
     // The exact method: its closed form in time (automatic harmonics kept the harmonics).
     if exact.is_none() {
         exact = solve_exact::again(&scene, &sol)?;

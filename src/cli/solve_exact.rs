@@ -1,6 +1,5 @@
 //! What `hbal solve` does differently for the exact piecewise solution: its multipliers are
-//! those of the exact monodromy matrix, its extremes those of the closed form in time; and the
-//! note that points harmonic balance's users to it.
+//! those of the exact monodromy matrix, its extremes those of the closed form in time.
 
 use super::Failure;
 use hbal::report::ElementOutput;
@@ -43,24 +42,5 @@ pub(crate) fn again(
             .map(Some)
             .map_err(|e| super::failure(e, &scene.file)),
         _ => Ok(None),
-    }
-}
-
-/// A note where harmonic balance leaves the harmonics 0..H of a scene with an error above 1e-6
-/// that the exact piecewise solution would solve exactly (linear, piecewise-constant
-/// coefficients: a rectangular mesh stiffness at low speed).
-pub(crate) fn hint(
-    scene: &hbal::scene::Scene,
-    estimate: Option<&Result<hbal::solve::ErrorEstimate, String>>,
-) {
-    let Some(Ok(e)) = estimate else { return };
-    if e.kept_harmonics > 1e-6
-        && !matches!(scene.method, hbal::solve::Method::PiecewiseExact(_))
-        && hbal::solve::PiecewiseExact::check(&scene.model).is_ok()
-    {
-        eprintln!(
-            "note: {}: the harmonics 0..H are estimated {:.1e} off; this scene is linear with piecewise-constant coefficients: `--method piecewise_exact` gives them, and the extremes in time, exactly",
-            scene.file, e.kept_harmonics
-        );
     }
 }

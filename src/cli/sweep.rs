@@ -140,7 +140,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         }
     }
     let mut basis = HarmonicBasis::new(from * per, scene.basis.harmonics())?
-        .with_tail_correction(scene.basis.tail_correction())
+        .with_tail_correction_of(&scene.basis)
         .with_samples(scene.basis.samples())
         .with_context(|| scene.file.clone())?;
     // Automatic harmonics: H chosen at the first speed, then kept along the branch.

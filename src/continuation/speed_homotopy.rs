@@ -40,7 +40,7 @@ pub fn solve_robustly(
     };
     for factor in [0.5, 2.0, 0.25, 4.0] {
         let far = HarmonicBasis::new(omega * factor, basis.harmonics())?
-            .with_tail_correction(basis.tail_correction())
+            .with_tail_correction_of(&basis)
             .with_samples(basis.samples())?;
         let branch = inner.run_from(model, far, omega, None, |_| {})?;
         if branch.stop != BranchStop::Reached {

@@ -110,7 +110,7 @@ impl Continuation {
         }
         // The parent's own period multiple (a branch born at an earlier period doubling has 2).
         let parent_basis = HarmonicBasis::new(pa.omega, parent.harmonics)?
-            .with_tail_correction(basis.tail_correction())
+            .with_tail_correction_of(&basis)
             .with_subharmonic(parent.subharmonic.max(1))?
             .with_samples(basis.samples() / ratio)?;
         // 1. Locate the branch point on the parent branch.

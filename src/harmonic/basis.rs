@@ -29,17 +29,14 @@ pub struct HarmonicBasis {
     #[serde(default = "one")]
     subharmonic: usize,
     /// Whether the harmonic balance corrects the coupling through the harmonics above H of
-    /// laws whose force jumps in time (see [`HarmonicBasis::with_tail_correction`]).
-    #[serde(default = "yes")]
-    tail: bool,
+    /// laws whose force jumps in time (see [`HarmonicBasis::with_tail_correction`]); `None`:
+    /// the default, off at a fixed H, on for automatic harmonics.
+    #[serde(default)]
+    tail: Option<bool>,
 }
 
 fn one() -> usize {
     1
-}
-
-fn yes() -> bool {
-    true
 }
 
 impl HarmonicBasis {
@@ -72,7 +69,7 @@ impl HarmonicBasis {
             harmonics,
             samples,
             subharmonic: 1,
-            tail: true,
+            tail: None,
         })
     }
 
@@ -136,7 +133,10 @@ impl HarmonicBasis {
         Ok(self)
     }
 
-    /// The same basis with the tail correction on (the default) or off.
+    /// The same basis with the tail correction on or off. By default it is off at a fixed H
+    /// (the plain Galerkin truncation, what other harmonic-balance tools compute) and on for
+    /// automatic harmonics ([`crate::solve::solve_auto`]), which reach a tolerance at a lower
+    /// H with it.
     ///
     /// Where a force law linear in the state has a coefficient that jumps in time (a
     /// rectangular mesh stiffness), the exact solution's harmonics above H decay only like
@@ -145,22 +145,37 @@ impl HarmonicBasis {
     /// `H < l ≤ L` with their dynamic stiffness taken as diagonal and its receptance
     /// `G_l ≈ −C/(lΩ)² + B/(lΩ)⁴` between the jumping elements (`C = Wᵀ M⁻¹ W`, `B` so that
     /// `G_H` is exact), see `residual::tail`. It switches itself off where the harmonics above
-    /// H are not mass-dominated.
+    /// H are not mass-dominated. Its price: four FFTs of 10H–20H samples per residual
+    /// evaluation and jumping element (six where the damping varies otherwise than with the stiffness),
+    /// and, as it is not in the Jacobian, a few more Newton steps.
     ///
     /// ```
     /// use hbal::HarmonicBasis;
     /// let b = HarmonicBasis::new(100.0, 32).unwrap();
-    /// assert!(b.tail_correction());
-    /// assert!(!b.with_tail_correction(false).tail_correction());
+    /// assert!(!b.tail_correction());
+    /// assert_eq!(b.tail_correction_setting(), None);
+    /// assert!(b.with_tail_correction(true).tail_correction());
     /// ```
     pub fn with_tail_correction(mut self, on: bool) -> Self {
-        self.tail = on;
+        self.tail = Some(on);
         self
     }
 
-    /// Whether the tail correction is on ([`HarmonicBasis::with_tail_correction`]).
+    /// Whether the tail correction is on at this fixed H ([`HarmonicBasis::with_tail_correction`]).
     pub fn tail_correction(&self) -> bool {
+        self.tail.unwrap_or(false)
+    }
+
+    /// The tail correction as set: `None` where it was left to the default (off at a fixed H,
+    /// on for automatic harmonics).
+    pub fn tail_correction_setting(&self) -> Option<bool> {
         self.tail
+    }
+
+    /// The same basis with the tail correction set as in `other` (also left to the default).
+    pub fn with_tail_correction_of(mut self, other: &HarmonicBasis) -> Self {
+        self.tail = other.tail;
+        self
     }
 
     /// Ω in rad/s: the excitation (shaft) frequency, the swept parameter.

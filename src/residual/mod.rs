@@ -204,6 +204,18 @@ impl<'m> HarmonicBalance<'m> {
         self.tail.as_ref().is_some_and(|t| t.applies())
     }
 
+    /// Whether the tail correction would apply at the current Ω with the basis turning it on
+    /// (the same as [`HarmonicBalance::tail_corrected`] where it does): a law linear in the
+    /// state jumps in time and the harmonics above H are mass-dominated. Costs a solve with
+    /// the factors of `Z_H` per jumping element.
+    pub fn tail_correction_would_apply(&self) -> bool {
+        self.tail_corrected()
+            || tail::TailCorrection::whatever_the_basis(self)
+                .ok()
+                .flatten()
+                .is_some_and(|t| t.applies())
+    }
+
     /// The force harmonics `0..=H` that the tail correction adds to each corrected element,
     /// `(element index in the model, harmonics)`, at the full harmonics `q` (`(H+1)·n` of
     /// the model's DOFs): with them, an element's force balances the equation of motion (see

@@ -17,8 +17,8 @@ pub(super) struct Harmonics {
     max: Option<usize>,
     /// What `auto` controls: `"solution"` (default) or `"harmonics"`.
     control: Option<crate::solve::Control>,
-    /// The tail correction of jumping coefficients (default on, see
-    /// [`HarmonicBasis::with_tail_correction`]).
+    /// The tail correction of jumping coefficients (default: off at a fixed H, on with
+    /// `auto`; see [`HarmonicBasis::with_tail_correction`]).
     tail_correction: Option<bool>,
 }
 
@@ -101,9 +101,11 @@ impl Harmonics {
                 ))
             }
         };
-        let mut basis = HarmonicBasis::new(omega, count)
-            .map_err(|e| fail("harmonics.count", e.to_string()))?
-            .with_tail_correction(self.tail_correction.unwrap_or(true));
+        let mut basis =
+            HarmonicBasis::new(omega, count).map_err(|e| fail("harmonics.count", e.to_string()))?;
+        if let Some(on) = self.tail_correction {
+            basis = basis.with_tail_correction(on);
+        }
         if let Some(s) = self.samples {
             basis = basis
                 .with_samples(s)

@@ -90,3 +90,65 @@ fn two_meshes_sharing_a_dof() {
     }
     assert!(corrected[1] < 1e-7, "{corrected:?}");
 }
+
+/// The default: off at a fixed H (the plain truncation, with a note where the correction
+/// would apply), on for automatic harmonics; `tail_correction = true` turns it on at a fixed
+/// H, `false` off also for automatic harmonics. The two-shaft model at 6000 rpm, H = 32.
+#[test]
+fn off_at_a_fixed_h_on_for_automatic_harmonics() {
+    use crate::piecewise_exact::{run, scene};
+    let with = std::fs::read_to_string(scene("two_shaft_6000rpm.toml")).unwrap();
+    assert!(with.contains("\ntail_correction = true\n"));
+    let dir = std::env::temp_dir().join(format!("hbal-tail-default-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = |name: &str, text: String| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let default = file(
+        "default.toml",
+        with.replace("\ntail_correction = true\n", "\n"),
+    );
+    let off = file(
+        "off.toml",
+        with.replace("tail_correction = true", "tail_correction = false"),
+    );
+    let kept = |args: &[&str]| {
+        let (code, out, err) = run(args);
+        assert_eq!(code, Some(0), "{err}");
+        let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+        (
+            json["error_estimate"]["kept_harmonics"].as_f64().unwrap(),
+            err,
+        )
+    };
+    let fixed = ["--json", "--no-stability"];
+    // Fixed H: the plain truncation (2.1e-4 estimated), and a note on the correction.
+    let (plain, err) = kept(&[&["solve", &default][..], &fixed].concat());
+    assert!((1e-4..5e-4).contains(&plain), "{plain:e}");
+    assert!(err.contains("`tail_correction = true`"), "{err}");
+    // Turned on: about 1e-6, no note on it.
+    let (on, err) = kept(&[&["solve", &scene("two_shaft_6000rpm.toml")][..], &fixed].concat());
+    assert!(on < 3e-6 && plain / on > 100.0, "{on:e}");
+    assert!(!err.contains("`tail_correction = true`"), "{err}");
+    // Turned off explicitly: no note on it either.
+    let (_, err) = kept(&[&["solve", &off][..], &fixed].concat());
+    assert!(!err.contains("`tail_correction = true`"), "{err}");
+    // Automatic harmonics on the harmonics 0..H: H = 32 with the correction by default.
+    let auto = ["--harmonics", "auto:harmonics", "--json", "--no-stability"];
+    let (code, out, err) = run(&[&["solve", &default][..], &auto].concat());
+    assert_eq!(code, Some(0), "{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(json["harmonics"], 32, "{}", json["harmonics"]);
+    // ... and without it where the scene turns it off: a higher H.
+    let (code, out, err) = run(&[&["solve", &off][..], &auto].concat());
+    assert_eq!(code, Some(0), "{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(
+        json["harmonics"].as_u64().unwrap() >= 128,
+        "{}",
+        json["harmonics"]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

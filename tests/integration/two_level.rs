@@ -53,7 +53,10 @@ fn two_level_map_at_600_rpm_reaches_1e5() {
     let shaft = TwoShaft::new(600.0);
     let model = shaft.model().unwrap();
     let omega = shaft.mesh_omega();
-    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(omega, 512).unwrap()).unwrap();
+    let basis = HarmonicBasis::new(omega, 512)
+        .unwrap()
+        .with_tail_correction(true);
+    let hb = HarmonicBalance::new(&model, basis).unwrap();
     let mut ws = hb.workspace();
     let base = Anderson::new()
         .with_tolerance(1e-12)

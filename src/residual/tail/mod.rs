@@ -96,13 +96,22 @@ pub struct TailBuffers {
 
 impl TailCorrection {
     /// The correction of `hb`, or `None` where it has nothing to correct: the basis has it off
-    /// or H = 0, no active law is linear in the state with jumps and a band-limited copy, the
-    /// envelope factor of M fails (a guard: models are built with M positive definite), or the
-    /// fine grid would exceed the largest basis.
+    /// or see [`TailCorrection::whatever_the_basis`].
     pub(super) fn new(hb: &HarmonicBalance) -> Result<Option<Self>> {
+        if !hb.basis.tail_correction() {
+            return Ok(None);
+        }
+        Self::whatever_the_basis(hb)
+    }
+
+    /// The correction of `hb` also where its basis has it off, or `None` where it has nothing
+    /// to correct: H = 0, no active law is linear in the state with jumps and a band-limited
+    /// copy, the envelope factor of M fails (a guard: models are built with M positive
+    /// definite), or the fine grid would exceed the largest basis.
+    pub(super) fn whatever_the_basis(hb: &HarmonicBalance) -> Result<Option<Self>> {
         let basis = hb.basis;
         let h = basis.harmonics();
-        if !basis.tail_correction() || h == 0 {
+        if h == 0 {
             return Ok(None);
         }
         let samples = (10 * h + 2).next_power_of_two();

@@ -93,7 +93,9 @@ fn harmonic_balance_converges_to_the_exact_harmonics() {
         .unwrap();
     let mut last = f64::INFINITY;
     for h in [16, 32, 64] {
-        let basis = HarmonicBasis::new(omega, h).unwrap();
+        let basis = HarmonicBasis::new(omega, h)
+            .unwrap()
+            .with_tail_correction(true);
         let hb = HarmonicBalance::new(&model, basis).unwrap();
         let mut ws = hb.workspace();
         let newton = crate::Newton::new().with_tolerance(1e-12).unwrap();
@@ -203,7 +205,10 @@ fn a_model_that_floats_free_has_its_rigid_motion_separated() {
     };
     let omega = 3000.0;
     let newton = |model: &Model, h: usize| {
-        let hb = HarmonicBalance::new(model, HarmonicBasis::new(omega, h).unwrap()).unwrap();
+        let basis = HarmonicBasis::new(omega, h)
+            .unwrap()
+            .with_tail_correction(true);
+        let hb = HarmonicBalance::new(model, basis).unwrap();
         crate::Newton::new()
             .with_tolerance(1e-12)
             .unwrap()
