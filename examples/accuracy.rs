@@ -133,7 +133,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut hb_points = Vec::new();
         let mut needed: Vec<(f64, Option<usize>)> = vec![(1e-2, None), (1e-4, None), (1e-6, None)];
         for &h in hs.iter() {
-            let hb = HarmonicBalance::new(model, HarmonicBasis::new(*omega, h)?)?;
+            let hb = HarmonicBalance::new(
+                model,
+                HarmonicBasis::new(*omega, h)?.with_tail_correction(true),
+            )?;
             let mut ws = hb.workspace();
             let method = if h <= 64 {
                 Method::Newton(Newton::new().with_tolerance(1e-12)?)

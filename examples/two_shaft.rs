@@ -146,7 +146,9 @@ fn speed_up_table(budget: Duration) -> Result<(), Box<dyn std::error::Error>> {
         let mut row = None;
         let mut last = String::from("no converged run");
         'search: for h in [32usize, 64, 128, 256, 512, 1024] {
-            let basis = HarmonicBasis::new(case.mesh_omega(), h)?.with_samples(16 * h)?;
+            let basis = HarmonicBasis::new(case.mesh_omega(), h)?
+                .with_samples(16 * h)?
+                .with_tail_correction(true);
             let hb = HarmonicBalance::new(&model, basis)?;
             let mut ws = hb.workspace();
             // The fastest converged of: the paper's iteration, Anderson on the paper's map and
