@@ -68,6 +68,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             let a = hbal::solve::solve_auto(&scene.model, scene.basis, &scene.method, auto)
                 .map_err(|e| super::failure(e, &scene.file))?;
             solve_seconds = started.elapsed().as_secs_f64();
+            exact = a.exact;
             (
                 a.solution,
                 Some(Ok(a.estimate)),
@@ -109,10 +110,6 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     };
     if scene.auto.is_some() || exact.is_some() {
         solve_hints::print(&scene, None, estimate.as_ref());
-    }
-    // The exact method: its closed form in time (automatic harmonics kept the harmonics).
-    if exact.is_none() {
-        exact = solve_exact::again(&scene, &sol)?;
     }
     let extremes = exact.as_ref().map(|e| e.extremes());
     // Stability of a converged orbit (an unconverged iterate is no orbit to judge).

@@ -1,9 +1,7 @@
 //! What `hbal solve` does differently for the exact piecewise solution: its multipliers are
 //! those of the exact monodromy matrix, its extremes those of the closed form in time.
 
-use super::Failure;
 use hbal::report::ElementOutput;
-use hbal::solution::Solution;
 use hbal::solve::piecewise::{ExactExtremes, ExactSolution};
 
 /// The element outputs with the exact extremes and mean forces where there are some.
@@ -28,19 +26,4 @@ pub(crate) fn time_series(exact: &ExactSolution) -> Option<Vec<Vec<f64>>> {
     let basis = exact.solution.basis();
     (basis.subharmonic() == 1)
         .then(|| exact.time_series(exact.resolving_points().max(basis.samples())))
-}
-
-/// The exact solution on the basis automatic harmonics chose, for its closed form; `None` for
-/// other methods.
-pub(crate) fn again(
-    scene: &hbal::scene::Scene,
-    sol: &Solution,
-) -> Result<Option<ExactSolution>, Failure> {
-    match &scene.method {
-        hbal::solve::Method::PiecewiseExact(method) => method
-            .solve_exact(&scene.model, sol.basis())
-            .map(Some)
-            .map_err(|e| super::failure(e, &scene.file)),
-        _ => Ok(None),
-    }
 }

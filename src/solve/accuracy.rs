@@ -230,6 +230,9 @@ pub struct AutoSolution {
     pub levels: Vec<Level>,
     /// `true` if the tolerance was not reached by `max_harmonics`.
     pub capped: bool,
+    /// The exact piecewise solution at the chosen H where the method is
+    /// [`Method::PiecewiseExact`] (its closed form in time, its multipliers).
+    pub exact: Option<crate::solve::piecewise::ExactSolution>,
 }
 
 /// Solves `model` at H = H0, 2 H0, ... from `basis` (its Ω, its H as H0 and its samples per
@@ -313,6 +316,7 @@ pub fn solve_auto(
                 estimate,
                 levels,
                 capped,
+                exact: None,
             });
         }
         level_basis = *fine.basis();
@@ -348,10 +352,11 @@ fn auto_exact(
         let capped = !reached && next > auto.max_harmonics;
         if reached || capped {
             return Ok(AutoSolution {
-                solution: e.solution,
+                solution: e.solution.clone(),
                 estimate: e.estimate,
                 levels,
                 capped,
+                exact: Some(e),
             });
         }
         level_basis = scaled(&level_basis, next)?;

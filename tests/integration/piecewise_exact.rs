@@ -237,6 +237,17 @@ fn automatic_harmonics_with_the_exact_method() {
     assert!(!a.capped && a.estimate.relative <= 1e-6, "{:?}", a.estimate);
     let err = relative_error(a.solution.harmonics(), &r.harmonics, 1, 32);
     assert!(err < 1e-10, "{err:.2e}");
+    // The exact solution of the chosen level comes along (its closed form, its multipliers):
+    // nobody solves it again. Harmonic balance has none.
+    let exact = a
+        .exact
+        .as_ref()
+        .expect("the exact solution of the last level");
+    assert_eq!(exact.solution.harmonics(), a.solution.harmonics());
+    assert_eq!(exact.solution.basis().harmonics(), 512);
+    let newton = Method::Newton(hbal::Newton::new());
+    let hb = solve_auto(&model, start, &newton, AutoHarmonics::default()).unwrap();
+    assert!(hb.exact.is_none());
 }
 
 /// The exact monodromy matrix's multipliers against the shared reference's moduli and the

@@ -250,21 +250,41 @@ pub fn find_crossings(
             out.push(c);
         }
     };
+    // Between samples `u` moves at most `h max |u_θ| ≤ h Σ k |u_k|`: a kink outside the
+    // samples' range by more is neither crossed nor grazed.
+    let (lowest, highest) = u
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, m), &x| {
+            (l.min(x), m.max(x))
+        });
+    let reach = h * uk
+        .iter()
+        .enumerate()
+        .map(|(k, c)| k as f64 * c.norm())
+        .sum::<f64>();
     for &kappa in kinks {
+        if kappa < lowest - reach || kappa > highest + reach {
+            continue;
+        }
+        // The scan is most of the cost where nothing is crossed: no division (modulo) and no
+        // conversion per sample.
+        let (mut b, mut vb) = (u[0] - kappa, du[0]);
         for j in 0..n {
+            let next = if j + 1 == n { 0 } else { j + 1 };
             // Sides as the laws draw them: `u > κ` above, `u = κ` below (a sample on the edge
             // belongs to the side below, so the crossing is still seen).
-            let (a, b) = (u[j] - kappa, u[(j + 1) % n] - kappa);
-            let (lo, hi) = (j as f64 * h, (j + 1) as f64 * h);
+            let (a, va) = (b, vb);
+            (b, vb) = (u[next] - kappa, du[next]);
             if (a > 0.0) != (b > 0.0) {
+                let (lo, hi) = (j as f64 * h, (j + 1) as f64 * h);
                 let t = root(uk, kappa, lo, hi, a > 0.0, lo + h * a / (a - b));
                 push(kappa, t, j);
                 continue;
             }
-            let (va, vb) = (du[j], du[(j + 1) % n]);
             if va * vb >= 0.0 {
                 continue;
             }
+            let (lo, hi) = (j as f64 * h, (j + 1) as f64 * h);
             // An extremum inside: can it reach the edge? (|u - u_j| <= max |u'| h.)
             if a.abs().min(b.abs()) > (va.abs() + vb.abs()) / fundamental * h {
                 continue;

@@ -146,3 +146,34 @@ fn grazing_between_samples_is_corrected() {
         .fold(0.0, f64::max);
     assert!(err < 1e-11, "{err}");
 }
+
+/// The range check that skips a kink: on 8 samples, `u = sin(θ − h/2)` peaks at 1 between
+/// two samples (0.924): edges at ±0.98 are grazed (two crossings each, found), edges at ±1.8
+/// lie beyond the samples' range plus the bound `h Σ k |u_k|` (0.79) and are skipped
+/// without a scan (none).
+#[test]
+fn kinks_out_of_reach_are_skipped_and_grazed_ones_are_not() {
+    use crate::force::{Backlash, MeshProfile};
+    let n = 8;
+    let h = TAU / n as f64;
+    let uk = [
+        Complex64::default(),
+        Complex64::new(0.0, -1.0) * Complex64::from_polar(1.0, -0.5 * h),
+    ];
+    let thetas: Vec<f64> = (0..n).map(|j| h * j as f64).collect();
+    let u: Vec<f64> = thetas.iter().map(|t| (t - 0.5 * h).sin()).collect();
+    let du: Vec<f64> = thetas.iter().map(|t| (t - 0.5 * h).cos()).collect();
+    assert!(u.iter().all(|x| x.abs() < 0.93));
+    let count = |edge: f64| {
+        let law = Backlash::new(edge, MeshProfile::Constant { stiffness: 3.0 });
+        let mut crossings = Vec::new();
+        find_crossings(&law, &law.kinks(), &u, &du, &uk, 1.0, 1, &mut crossings);
+        for c in &crossings {
+            let at = (c.theta - 0.5 * h).sin().abs();
+            assert!((at - edge).abs() < 1e-12, "{edge}: crossing at |u| = {at}");
+        }
+        crossings.len()
+    };
+    assert_eq!(count(0.98), 4);
+    assert_eq!(count(1.8), 0);
+}
