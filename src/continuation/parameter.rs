@@ -55,23 +55,10 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
             }
         };
         let model: &Model = model.borrow();
-        let mut hb = match HarmonicBalance::with_formulation(model, basis, formulation) {
-            Ok(hb) => hb,
-            // After the first point, a numerical failure ends the branch and keeps its points.
-            Err(e) => {
-                end_here(&mut branch, e, |reason| BranchStop::Failed {
-                    parameter: p,
-                    reason,
-                })?;
-                break;
-            }
-        };
-        crate::solve::check_dense_for_continuation(&hb)?;
-        let mut ws = hb.workspace();
-        let full = (basis.harmonics() + 1) * model.n_dofs();
         let mut exact = None;
-        let sol = match (&cont.method, &previous) {
-            (Method::PiecewiseExact(method), _) => match method.solve_exact(model, &basis) {
+        let sol = if let Method::PiecewiseExact(method) = &cont.method {
+            // No harmonic balance to build: every value is solved exactly.
+            match method.solve_exact(model, &basis) {
                 Ok(e) => {
                     branch
                         .get_or_insert_with(|| Branch::new(model, basis, "piecewise_exact".into()));
@@ -86,31 +73,49 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
                     })?;
                     break;
                 }
-            },
-            (_, Some(q)) if q.len() == full => {
-                match Newton::new()
-                    .with_tolerance(cont.tolerance)?
-                    .solve_from(&hb, q, &mut ws)
-                {
-                    // No finite residual from the previous point: Newton fails here.
-                    Err(Error::NonFinite { .. }) => {
-                        if let Some(b) = branch.as_mut() {
-                            b.stop = BranchStop::NotConverged { parameter: p };
-                        }
-                        break;
-                    }
-                    r => r?,
-                }
             }
-            // The first value: the robust start (other solvers, load homotopy).
-            _ => {
-                let start = robust_start(&mut hb, &cont.method, None, cont.tolerance, &mut ws)?;
-                if let Some(b) = branch.as_mut() {
-                    b.start = start.how;
-                } else {
-                    branch = Some(Branch::new(model, basis, start.how));
+        } else {
+            let mut hb = match HarmonicBalance::with_formulation(model, basis, formulation) {
+                Ok(hb) => hb,
+                // After the first point, a numerical failure ends the branch and keeps its
+                // points.
+                Err(e) => {
+                    end_here(&mut branch, e, |reason| BranchStop::Failed {
+                        parameter: p,
+                        reason,
+                    })?;
+                    break;
                 }
-                start.solution
+            };
+            crate::solve::check_dense_for_continuation(&hb)?;
+            let mut ws = hb.workspace();
+            let full = (basis.harmonics() + 1) * model.n_dofs();
+            match &previous {
+                Some(q) if q.len() == full => {
+                    match Newton::new()
+                        .with_tolerance(cont.tolerance)?
+                        .solve_from(&hb, q, &mut ws)
+                    {
+                        // No finite residual from the previous point: Newton fails here.
+                        Err(Error::NonFinite { .. }) => {
+                            if let Some(b) = branch.as_mut() {
+                                b.stop = BranchStop::NotConverged { parameter: p };
+                            }
+                            break;
+                        }
+                        r => r?,
+                    }
+                }
+                // The first value: the robust start (other solvers, load homotopy).
+                _ => {
+                    let start = robust_start(&mut hb, &cont.method, None, cont.tolerance, &mut ws)?;
+                    if let Some(b) = branch.as_mut() {
+                        b.start = start.how;
+                    } else {
+                        branch = Some(Branch::new(model, basis, start.how));
+                    }
+                    start.solution
+                }
             }
         };
         let b = branch.get_or_insert_with(|| Branch::new(model, basis, String::new()));

@@ -287,6 +287,17 @@ pub(super) fn factor_at(
 }
 
 impl Configuration {
+    /// The positions of the steady state at `theta`, `Re Σ_k Q_k e^{ikθ}`, into `out` (`n`).
+    pub(super) fn steady_positions_into(&self, theta: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        for (order, block) in self.steady.chunks(self.n).enumerate() {
+            let e = Complex64::from_polar(1.0, order as f64 * theta);
+            for (o, q) in out.iter_mut().zip(block) {
+                *o += (q * e).re;
+            }
+        }
+    }
+
     /// The steady state `(q, q̇)` at angle `θ`.
     pub(super) fn steady_state(&self, theta: f64, omega: f64) -> DVector<f64> {
         let n = self.n;

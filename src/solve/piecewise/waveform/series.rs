@@ -2,12 +2,12 @@
 
 use super::Waveform;
 use crate::stability::expm::ExpWork;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
 impl Waveform {
     /// `q_i(θ_j)`, `θ_j = 2π j / points` (`[i][j]`): per piece one exponential to its first
-    /// sample and one step `e^{A_p δ}` between samples.
+    /// sample and one step `e^{A_p δ}` between samples, without allocating per sample.
     pub(in crate::solve::piecewise) fn time_series(&self, points: usize) -> Vec<Vec<f64>> {
         let s = &self.schedule;
         let (n, omega) = (s.n, s.omega);
@@ -28,6 +28,9 @@ impl Waveform {
             })
             .collect();
         let mut lead = DMatrix::zeros(2 * n, 2 * n);
+        // Buffers: no allocation per sample.
+        let mut steady = vec![0.0; n];
+        let mut next = DVector::zeros(2 * n);
         // Pieces cover [θ_0, θ_0 + 2π): sample j' lies in piece p for
         // index(θ_p) <= j' < index(θ_{p+1}), the last piece ending at index(θ_0) + points so
         // that every sample j' mod points is written once, whatever the rounding.
@@ -51,15 +54,16 @@ impl Waveform {
             let config = &s.configurations[piece.configuration];
             let theta = first as f64 * spacing;
             work.exp(&config.generator, (theta - piece.start) / omega, &mut lead);
+            // The free motion in the scaled state `(q, q̇/ω_s)`: its first n rows are the
+            // positions themselves.
             let mut scaled = &lead * s.scale_state(h.clone());
             for j in first..end {
-                let theta = j as f64 * spacing;
-                let steady = config.steady_state(theta, omega);
-                let x = s.unscale_state(scaled.clone());
+                config.steady_positions_into(j as f64 * spacing, &mut steady);
                 for (i, row) in out.iter_mut().enumerate() {
-                    row[j % points] = steady[i] + x[i];
+                    row[j % points] = steady[i] + scaled[i];
                 }
-                scaled = &steps[piece.configuration] * scaled;
+                next.gemv(1.0, &steps[piece.configuration], &scaled, 0.0);
+                std::mem::swap(&mut scaled, &mut next);
             }
         }
         out
