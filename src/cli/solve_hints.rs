@@ -41,8 +41,8 @@ fn tail_correction(scene: &Scene, hb: &HarmonicBalance) -> Option<String> {
     (unset && hb.tail_correction_would_apply()).then(|| {
         format!(
             "a coefficient jumps in time and the harmonics above H = {} are mass-dominated: \
-             `tail_correction = true` in [harmonics] (or `--harmonics auto`) adds their \
-             coupling to the kept ones (the two-shaft model at 6000 rpm: 2.7e-4 -> 8.9e-7 at \
+             `tail_correction = true` in [harmonics] (or `--harmonics auto:harmonics`) adds \
+             their coupling to the kept ones (the two-shaft model at 6000 rpm: 2.7e-4 -> 8.9e-7 at \
              H = 32)",
             scene.basis.harmonics()
         )

@@ -238,3 +238,41 @@ fn check_omega(omega: f64) -> Result<()> {
         ))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::HarmonicBasis;
+
+    /// The tail correction's setting in files: missing or `null` is the default (`None`),
+    /// `true`/`false` as set (files from before the default changed keep their `true`).
+    #[test]
+    fn tail_setting_reads_back() {
+        let b = HarmonicBasis::new(3.0, 8).unwrap();
+        let text = serde_json::to_string(&b).unwrap();
+        let back: HarmonicBasis = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.tail_correction_setting(), None);
+        let on = serde_json::to_string(&b.with_tail_correction(true)).unwrap();
+        let back: HarmonicBasis = serde_json::from_str(&on).unwrap();
+        assert_eq!(back.tail_correction_setting(), Some(true));
+        let old = r#"{"omega":3.0,"harmonics":8,"samples":64,"tail":true}"#;
+        let back: HarmonicBasis = serde_json::from_str(old).unwrap();
+        assert!(back.tail_correction() && back.subharmonic() == 1);
+        let missing = r#"{"omega":3.0,"harmonics":8,"samples":64}"#;
+        let back: HarmonicBasis = serde_json::from_str(missing).unwrap();
+        assert_eq!(back.tail_correction_setting(), None);
+        assert!(!back.tail_correction());
+        // Copied as set, also when left to the default.
+        let other = HarmonicBasis::new(5.0, 16).unwrap();
+        assert_eq!(
+            other.with_tail_correction_of(&b).tail_correction_setting(),
+            None
+        );
+        let set = b.with_tail_correction(false);
+        assert_eq!(
+            other
+                .with_tail_correction_of(&set)
+                .tail_correction_setting(),
+            Some(false)
+        );
+    }
+}

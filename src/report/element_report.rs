@@ -27,7 +27,8 @@ use num_complex::Complex64;
 ///     .build()?;
 /// let mut report = ElementReport::new(&model);
 /// for omega in [0.3, 0.35] {
-///     let hb = HarmonicBalance::new(&model, HarmonicBasis::new(omega, 16)?)?;
+///     let basis = HarmonicBasis::new(omega, 16)?.with_tail_correction(true);
+///     let hb = HarmonicBalance::new(&model, basis)?;
 ///     let sol = Newton::new().solve(&hb, &mut hb.workspace())?;
 ///     // The same force as from a harmonic balance built for this solution alone.
 ///     let (reused, alone) = (&report.outputs(&sol)?[0].force, &element_outputs(&model, &sol)?[0].force);

@@ -206,8 +206,10 @@ impl<'m> HarmonicBalance<'m> {
 
     /// Whether the tail correction would apply at the current Ω with the basis turning it on
     /// (the same as [`HarmonicBalance::tail_corrected`] where it does): a law linear in the
-    /// state jumps in time and the harmonics above H are mass-dominated. Costs a solve with
-    /// the factors of `Z_H` per jumping element.
+    /// state jumps in time and the harmonics above H are mass-dominated. Builds the
+    /// correction once: its FFT plan on 10H–20H samples, a factor of M, the coefficient tables
+    /// and a solve with the factors of `Z_H` per jumping element (the 1000-DOF drivetrain:
+    /// 0.3–13 ms).
     pub fn tail_correction_would_apply(&self) -> bool {
         self.tail_corrected()
             || tail::TailCorrection::whatever_the_basis(self)

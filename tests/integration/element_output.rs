@@ -302,3 +302,29 @@ fn unconverged_outputs_say_so() {
     assert!(svg.contains("at 1 rad_s"), "speed in the title");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The exact piecewise solution at a fixed H (where harmonic balance leaves the tail
+/// correction off by default): its mesh force still balances the equation of motion, with the
+/// correction's part of the harmonics above H the exact solution has: `f_1 = L_1 + Ω² M Q_1`
+/// on the one-DOF two-shaft model at 6000 rpm, H = 32 (3.2201; without that part 3.2198).
+#[test]
+fn the_exact_solutions_mesh_force_balances_the_equation_of_motion() {
+    use hbal::catalog::TwoShaft;
+    use hbal::solve::PiecewiseExact;
+    use hbal::HarmonicBasis;
+    let case = TwoShaft::new(6000.0);
+    let model = case.model().unwrap();
+    let basis = HarmonicBasis::new(case.mesh_omega(), 32).unwrap();
+    let exact = PiecewiseExact::new().solve_exact(&model, &basis).unwrap();
+    let out = element_outputs(&model, &exact.solution).unwrap();
+    let f1 = out[0].force.harmonics[1];
+    let w = case.mesh_omega();
+    let q1 = exact.solution.harmonics()[1];
+    let l = model.loads().iter().find(|l| l.order == 1).unwrap();
+    let load = hbal::num_complex::Complex64::new(l.cos, -l.sin);
+    let balance = load + w * w * model.mass().get(0, 0) * q1;
+    assert!(
+        (f1 - balance).norm() < 1e-5 * balance.norm(),
+        "{f1} against {balance}"
+    );
+}

@@ -132,6 +132,22 @@ fn off_at_a_fixed_h_on_for_automatic_harmonics() {
     let (on, err) = kept(&[&["solve", &scene("two_shaft_6000rpm.toml")][..], &fixed].concat());
     assert!(on < 3e-6 && plain / on > 100.0, "{on:e}");
     assert!(!err.contains("`tail_correction = true`"), "{err}");
+    // --harmonics N keeps the scene's setting: on at H = 64, far below the plain 64's error.
+    let (at64, err) = kept(
+        &[
+            &[
+                "solve",
+                &scene("two_shaft_6000rpm.toml"),
+                "--harmonics",
+                "64",
+            ][..],
+            &fixed,
+        ]
+        .concat(),
+    );
+    let (plain64, _) = kept(&[&["solve", &default, "--harmonics", "64"][..], &fixed].concat());
+    assert!(at64 < plain64 / 100.0, "{at64:e} {plain64:e}");
+    assert!(!err.contains("`tail_correction = true`"), "{err}");
     // Turned off explicitly: no note on it either.
     let (_, err) = kept(&[&["solve", &off][..], &fixed].concat());
     assert!(!err.contains("`tail_correction = true`"), "{err}");

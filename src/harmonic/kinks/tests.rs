@@ -147,33 +147,53 @@ fn grazing_between_samples_is_corrected() {
     assert!(err < 1e-11, "{err}");
 }
 
-/// The range check that skips a kink: on 8 samples, `u = sin(θ − h/2)` peaks at 1 between
-/// two samples (0.924): edges at ±0.98 are grazed (two crossings each, found), edges at ±1.8
-/// lie beyond the samples' range plus the bound `h Σ k |u_k|` (0.79) and are skipped
-/// without a scan (none).
+/// The range check that skips a kink, where the bound `h Σ k |u_k|` matters: on 18 samples,
+/// `u = sin(6θ + π/6)` peaks at 1 midway between samples (which reach only 0.5) and bottoms
+/// out on samples. Edges at ±0.999 are crossed 24 times (a scan of 2^16 samples agrees): the
+/// peaks are 0.5 above every sample, more than `h Σ |u_k|` (0.35) but less than
+/// `h Σ k |u_k|` (2.1), so a bound without the factor k would skip the upper edge and lose 12.
+/// Edges at ±8 are beyond the bound and skipped (none). Ω = 2.5, so that `du` in time and
+/// `u_θ` differ.
 #[test]
 fn kinks_out_of_reach_are_skipped_and_grazed_ones_are_not() {
     use crate::force::{Backlash, MeshProfile};
-    let n = 8;
+    let (n, order, omega) = (18, 6, 2.5);
     let h = TAU / n as f64;
-    let uk = [
-        Complex64::default(),
-        Complex64::new(0.0, -1.0) * Complex64::from_polar(1.0, -0.5 * h),
-    ];
+    let phase = std::f64::consts::FRAC_PI_6;
+    let mut uk = vec![Complex64::default(); order + 1];
+    uk[order] = Complex64::from_polar(1.0, phase - std::f64::consts::FRAC_PI_2);
+    let at = |t: f64| (order as f64 * t + phase).sin();
     let thetas: Vec<f64> = (0..n).map(|j| h * j as f64).collect();
-    let u: Vec<f64> = thetas.iter().map(|t| (t - 0.5 * h).sin()).collect();
-    let du: Vec<f64> = thetas.iter().map(|t| (t - 0.5 * h).cos()).collect();
-    assert!(u.iter().all(|x| x.abs() < 0.93));
+    let u: Vec<f64> = thetas.iter().map(|&t| at(t)).collect();
+    let du: Vec<f64> = thetas
+        .iter()
+        .map(|t| omega * order as f64 * (order as f64 * t + phase).cos())
+        .collect();
+    assert!(u.iter().all(|&x| x < 0.5 + 1e-12));
     let count = |edge: f64| {
         let law = Backlash::new(edge, MeshProfile::Constant { stiffness: 3.0 });
         let mut crossings = Vec::new();
-        find_crossings(&law, &law.kinks(), &u, &du, &uk, 1.0, 1, &mut crossings);
+        find_crossings(&law, &law.kinks(), &u, &du, &uk, omega, 1, &mut crossings);
         for c in &crossings {
-            let at = (c.theta - 0.5 * h).sin().abs();
-            assert!((at - edge).abs() < 1e-12, "{edge}: crossing at |u| = {at}");
+            assert!(
+                (at(c.theta).abs() - edge).abs() < 1e-12,
+                "{edge}: at {}",
+                c.theta
+            );
         }
         crossings.len()
     };
-    assert_eq!(count(0.98), 4);
-    assert_eq!(count(1.8), 0);
+    let fine = 1 << 16;
+    let dense = (0..fine)
+        .filter(|&j| {
+            let (a, b) = (
+                at(TAU * j as f64 / fine as f64),
+                at(TAU * (j + 1) as f64 / fine as f64),
+            );
+            ((a - 0.999) > 0.0) != ((b - 0.999) > 0.0) || ((a + 0.999) > 0.0) != ((b + 0.999) > 0.0)
+        })
+        .count();
+    assert_eq!(dense, 24);
+    assert_eq!(count(0.999), 24);
+    assert_eq!(count(8.0), 0);
 }

@@ -64,8 +64,6 @@ pub(crate) fn corrects(law: &dyn ForceLaw) -> bool {
 pub(super) struct TailCorrection {
     /// The fine grid: L harmonics on `N_T` samples.
     plan: AftPlan,
-    /// `N_T`, the fine grid's samples.
-    samples: usize,
     elements: Vec<TailElement>,
     /// `C = Wᵀ M⁻¹ W` over the jumping elements, row-major.
     mobility: Vec<f64>,
@@ -77,9 +75,9 @@ pub(super) struct TailCorrection {
     /// mass-dominated (`|R| ≤ 0.3 |C/s_H²|`), 0 where they are not (`≥ 0.5`), linear between,
     /// so that the residual does not jump with Ω.
     weight: f64,
-    /// `weight · G_l[b, a]` at `l = H+1..=L`, harmonic-major (`(l − H − 1) m² + b m + a`),
-    /// from the model below at the current Ω.
-    weighted_receptance: Vec<Complex64>,
+    /// `r_l = H/l` at `l = H+1..=L`, the receptance model's variable (no division per
+    /// evaluation; the receptance itself is formed per use, so memory stays O(L), not O(L m²)).
+    ratios: Vec<f64>,
 }
 
 /// Buffers of the tail correction (empty without one).
@@ -147,14 +145,13 @@ impl TailCorrection {
             return Ok(None);
         };
         let mut tail = Self {
-            samples,
             plan: AftPlan::new(fine),
             mass_h: vec![0.0; mobility.len()],
             rest_h: vec![Complex64::default(); mobility.len()],
             mobility,
             elements,
             weight: 0.0,
-            weighted_receptance: Vec::new(),
+            ratios: (h + 1..=top).map(|l| h as f64 / l as f64).collect(),
         };
         tail.fit(hb);
         Ok(Some(tail))
@@ -195,14 +192,6 @@ impl TailCorrection {
         } else {
             0.0
         };
-        let (top, m2) = (self.plan.basis().harmonics(), m * m);
-        let table = (h + 1..=top).flat_map(|l| {
-            let r = h as f64 / l as f64;
-            (0..m2).map(move |i| (i, r))
-        });
-        self.weighted_receptance = table
-            .map(|(i, r)| self.receptance(i, r) * self.weight)
-            .collect();
     }
 
     /// Whether the correction is applied at the current Ω (with a positive weight).
@@ -250,7 +239,6 @@ impl TailCorrection {
             }
         });
         ws.ffts += 2 * self.elements.iter().map(|e| e.ffts()).sum::<usize>();
-        ws.force_evaluations += 2 * self.elements.len() * self.samples;
     }
 
     /// The force harmonics `0..=H` the tail adds to every jumping element, `each(index
@@ -284,13 +272,12 @@ impl TailCorrection {
         // The tail of every element's coordinate and its force on the kept harmonics.
         for (b, te) in self.elements.iter().enumerate() {
             tb.uk.fill(Complex64::default());
-            let receptances = self.weighted_receptance.chunks_exact(m * m);
-            for (l, g) in (h + 1..=top).zip(receptances) {
+            for (l, &r) in (h + 1..=top).zip(&self.ratios) {
                 let mut v = Complex64::default();
-                for (a, g) in g[b * m..(b + 1) * m].iter().enumerate() {
-                    v -= g * tb.spectra[a * (top + 1) + l];
+                for a in 0..m {
+                    v -= self.receptance(b * m + a, r) * tb.spectra[a * (top + 1) + l];
                 }
-                tb.uk[l] = v;
+                tb.uk[l] = v * self.weight;
             }
             te.force_harmonics(
                 &self.plan, omega, &tb.uk, &mut tb.u, &mut tb.du, &mut tb.vk, aft,
