@@ -55,6 +55,10 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
             }
         };
         let model: &Model = model.borrow();
+        let failed = |reason| BranchStop::Failed {
+            parameter: p,
+            reason,
+        };
         let mut exact = None;
         let sol = if let Method::PiecewiseExact(method) = &cont.method {
             // No harmonic balance to build: every value is solved exactly.
@@ -67,10 +71,7 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
                     sol
                 }
                 Err(e) => {
-                    end_here(&mut branch, e, |reason| BranchStop::Failed {
-                        parameter: p,
-                        reason,
-                    })?;
+                    end_here(&mut branch, e, failed)?;
                     break;
                 }
             }
@@ -80,10 +81,7 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
                 // After the first point, a numerical failure ends the branch and keeps its
                 // points.
                 Err(e) => {
-                    end_here(&mut branch, e, |reason| BranchStop::Failed {
-                        parameter: p,
-                        reason,
-                    })?;
+                    end_here(&mut branch, e, failed)?;
                     break;
                 }
             };

@@ -22,6 +22,7 @@
 use super::exponential::ExpFlow;
 use super::record::Step;
 use crate::error::{Error, Result};
+use crate::harmonic::kinks::{bracketed_newton, derivatives};
 use crate::harmonic::{AftPlan, HarmonicBasis};
 use crate::model::Model;
 use num_complex::Complex64;
@@ -89,8 +90,8 @@ impl ExpFlow<'_, '_> {
                         self.emit(record, step);
                         let theta = (end * fundamental).rem_euclid(TAU);
                         let hb = |e: usize| {
-                            let (u, slope) = value_and_slope(&coordinates[e], theta);
-                            (u, slope * fundamental)
+                            let d = derivatives(&coordinates[e], theta);
+                            (d[0], d[1] * fundamental)
                         };
                         if !self.coefficients_hold(&piece, angle(end), hb) {
                             return Ok(false);
@@ -181,22 +182,6 @@ impl ExpFlow<'_, '_> {
     }
 }
 
-/// `(u(θ), u'(θ))` of `u = Re Σ_k U_k e^{ikθ}`.
-fn value_and_slope(u: &[Complex64], theta: f64) -> (f64, f64) {
-    let (mut v, mut d) = (0.0, 0.0);
-    let rot = Complex64::from_polar(1.0, theta);
-    let mut z = Complex64::new(1.0, 0.0);
-    for (k, uk) in u.iter().enumerate() {
-        if k > 0 {
-            z *= rot;
-        }
-        let c = uk * z;
-        v += c.re;
-        d -= k as f64 * c.im;
-    }
-    (v, d)
-}
-
 /// The harmonics `U_e,k = w_e·Q_k` of every element's coordinate (`harmonics` in the model's
 /// DOFs, harmonic-major).
 fn element_harmonics(model: &Model, harmonics: &[Complex64]) -> Vec<Vec<Complex64>> {
@@ -222,38 +207,18 @@ fn element_harmonics(model: &Model, harmonics: &[Complex64]) -> Vec<Vec<Complex6
 /// to `b` (opposite signs): safeguarded Newton from the secant's root, bisection where a step
 /// leaves the bracket. `(θ*, u'(θ*))`, `θ*` in `[0, 2π)`.
 fn root(u: &[Complex64], kink: f64, theta0: f64, delta: f64, a: f64, b: f64) -> (f64, f64) {
-    let eval = |t: f64| {
-        let (v, d) = value_and_slope(u, t);
-        (v - kink, d)
-    };
-    let (mut lo, mut hi) = (theta0, theta0 + delta);
-    let rising = b > a;
-    let mut t = theta0 + delta * a / (a - b);
-    let mut slope = (b - a) / delta;
-    for _ in 0..60 {
-        let (g, d) = eval(t);
-        slope = d;
-        if g == 0.0 {
-            break;
-        }
-        if (g > 0.0) == rising {
-            hi = t;
-        } else {
-            lo = t;
-        }
-        let newton = t - g / d;
-        let next = if d != 0.0 && newton > lo && newton < hi {
-            newton
-        } else {
-            0.5 * (lo + hi)
-        };
-        if (next - t).abs() <= 1e-15 * TAU {
-            t = next;
-            break;
-        }
-        t = next;
-    }
-    (t.rem_euclid(TAU), slope)
+    let t = bracketed_newton(
+        theta0,
+        theta0 + delta,
+        theta0 + delta * a / (a - b),
+        a > 0.0,
+        0.0,
+        |t| {
+            let d = derivatives(u, t);
+            (d[0] - kink, d[1])
+        },
+    );
+    (t.rem_euclid(TAU), derivatives(u, t)[1])
 }
 
 #[cfg(test)]

@@ -198,7 +198,7 @@ fn correct(
 }
 
 /// `(u, u', u'', u''')` at θ of `u(θ) = Re Σ_k U_k e^{ikθ}`.
-fn derivatives(uk: &[Complex64], theta: f64) -> [f64; 4] {
+pub(crate) fn derivatives(uk: &[Complex64], theta: f64) -> [f64; 4] {
     let step = Complex64::from_polar(1.0, theta);
     let mut e = Complex64::new(1.0, 0.0);
     let mut out = [0.0; 4];
@@ -322,7 +322,7 @@ fn extremum(uk: &[Complex64], lo: f64, hi: f64, rising: bool) -> f64 {
 /// The zero of `g` in `[lo, hi]` (`g > 0` at `lo` if `lo_positive`), by Newton from `t` with
 /// `f(t) = (g, g')`, kept inside the shrinking bracket (bisection where a step leaves it);
 /// stops at `|g| <= tol` or a step of 1e-15 of a period.
-fn bracketed_newton(
+pub(crate) fn bracketed_newton(
     mut lo: f64,
     mut hi: f64,
     t: f64,
