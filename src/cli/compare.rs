@@ -4,7 +4,7 @@
 
 use super::{load, Failure, SolverArgs};
 use anyhow::Context;
-use hbal::compare::relative_error;
+use hbal::compare::model_relative_error;
 use hbal::report::{line_plot, Axis, Series};
 use hbal::timesim::TimeSimulation;
 use hbal::{HarmonicBalance, Method};
@@ -90,7 +90,7 @@ pub(crate) fn compare(
     let mut histories = Vec::new();
     let mut any_converged = false;
     for (name, seconds, sol) in &solutions {
-        let error = relative_error(sol.harmonics(), &td.harmonics, n, h);
+        let error = model_relative_error(&scene.model, sol.harmonics(), &td.harmonics, h);
         any_converged |= sol.is_converged();
         histories.push(Series::line(
             *name,

@@ -19,6 +19,7 @@
 //! [`ForceLaw`] in your own crate for anything else and check its derivatives with
 //! [`check_derivatives`].
 
+pub(crate) mod affine;
 mod backlash;
 mod check;
 mod cubic_spring;

@@ -92,6 +92,19 @@ impl AftPlan {
             .process_with_scratch(&mut s.spectrum, out, &mut s.scratch);
     }
 
+    /// Writes `x_j = Σ_{|m|<=M} c_m e^{imθ_j}` (`c_{-m} = conj c_m`) into `out` (length N)
+    /// from the normalised coefficients `c_m = bins[m]`, `m = 0..=M` (`M < N/2`, the
+    /// inverse of [`AftPlan::spectrum_into`] for a band-limited signal).
+    pub fn synthesize_bins_into(&self, bins: &[Complex64], out: &mut [f64], s: &mut AftScratch) {
+        s.spectrum.fill(Complex64::default());
+        let top = bins.len().min(s.spectrum.len() - 1);
+        s.spectrum[..top].copy_from_slice(&bins[..top]);
+        s.spectrum[0].im = 0.0;
+        let _ = self
+            .inverse
+            .process_with_scratch(&mut s.spectrum, out, &mut s.scratch);
+    }
+
     /// Writes the harmonics `0..=H` of the samples `x` (length N, overwritten) into `out`.
     pub fn analyze_into(&self, x: &mut [f64], out: &mut [Complex64], s: &mut AftScratch) {
         let h = self.basis.harmonics();

@@ -42,6 +42,11 @@ pub(super) struct ActiveElement {
     pub(super) jump_samples: Vec<usize>,
     /// The law's kinks in `u`, whose crossings the quadrature corrects.
     pub(super) kinks: Vec<f64>,
+    /// Whether the law (its own, not the band-limited copy) is affine on its pieces, so that
+    /// its harmonics are exact across its kinks (`exact_kinks`).
+    pub(super) exact_pieces: bool,
+    /// The law's time jumps as angles on the fundamental, `(b + 2πr)/ν`.
+    pub(super) time_breaks: Vec<f64>,
 }
 
 impl ActiveElement {
@@ -77,6 +82,18 @@ impl ActiveElement {
                     .collect();
                 jump_samples.sort_unstable();
                 jump_samples.dedup();
+                let own = e.law();
+                let time_breaks: Vec<f64> = own
+                    .time_breakpoints()
+                    .iter()
+                    .filter(|b| b.is_finite())
+                    .flat_map(|&b| (0..nu).map(move |r| (b + TAU * r as f64) / nu as f64))
+                    .collect();
+                let kinks = own.kinks();
+                let reach = kinks.iter().fold(1.0_f64, |m, k| m.max(4.0 * k.abs()));
+                let exact_pieces = !kinks.is_empty()
+                    && own.memory().is_none()
+                    && crate::force::affine::affine_law(own, reach, 1.0);
                 // A law with memory is marched (no kink quadrature, no time jumps).
                 if law.memory().is_some() {
                     jump_samples.clear();
@@ -91,6 +108,8 @@ impl ActiveElement {
                     },
                     band_limited,
                     jump_samples,
+                    exact_pieces,
+                    time_breaks,
                 }
             })
             .collect()
@@ -143,59 +162,49 @@ impl HarmonicBalance<'_> {
             }
             ws.force_evaluations += self.basis.samples() + 2 * act.jump_samples.len();
             self.samples(ws).check("force", e.name(), &ws.f)?;
-            // Contact edges crossed between samples: the trapezoid error, from the local
-            // harmonics still in `uk` (see [`crate::harmonic::kinks`]).
+            // Contact edges crossed between samples: exact harmonics for a law affine on its
+            // pieces, else the trapezoid error corrected (see [`crate::harmonic::kinks`]), from
+            // the local harmonics still in `uk`.
             ws.crossings.clear();
+            ws.edges.clear();
+            let mut exact = false;
             if !act.kinks.is_empty() {
-                crate::harmonic::kinks::find_crossings(
-                    law,
-                    &act.kinks,
-                    &ws.u,
-                    &ws.du,
-                    &ws.uk,
-                    omega,
-                    self.basis.subharmonic(),
-                    &mut ws.crossings,
-                );
-                ws.force_evaluations += 12 * ws.crossings.len();
+                let kinks = &crate::harmonic::kinks::find_edge_crossings;
+                kinks(&act.kinks, &ws.u, &ws.du, &ws.uk, omega, &mut ws.edges);
+                exact = act.exact_pieces
+                    && !ws.edges.is_empty()
+                    && self.exact_kinks_into(act, e.law(), &lin, ws);
+                if !exact {
+                    crate::harmonic::kinks::crossing_jumps(
+                        law,
+                        &ws.edges,
+                        &ws.uk,
+                        omega,
+                        self.basis.subharmonic(),
+                        self.basis.samples(),
+                        &mut ws.crossings,
+                    );
+                    ws.force_evaluations += 12 * ws.crossings.len();
+                }
             }
-            self.aft.analyze_into(&mut ws.f, &mut ws.uk, &mut ws.aft);
-            ws.ffts += 3;
-            crate::harmonic::kinks::correct_harmonics(
-                &mut ws.uk,
-                self.basis.samples(),
-                &ws.crossings,
-            );
+            if !exact {
+                self.aft.analyze_into(&mut ws.f, &mut ws.uk, &mut ws.aft);
+                ws.ffts += 3;
+                crate::harmonic::kinks::correct_harmonics(
+                    &mut ws.uk,
+                    self.basis.samples(),
+                    &ws.crossings,
+                );
+            } else {
+                ws.ffts += 2;
+            }
             for k in 0..=h {
                 scatter_add(&act.weights, ws.uk[k], &mut out[k * n..(k + 1) * n]);
             }
             if let Some(jac) = jac.as_deref_mut() {
-                self.derivative_samples(act, ws);
-                for (g, d) in ws.gu.iter_mut().zip(ws.gdu.iter_mut()) {
-                    *g -= lin.stiffness;
-                    *d -= lin.damping;
+                if !exact {
+                    self.element_spectra(act, &lin, e.name(), ws)?;
                 }
-                let samples = self.samples(ws);
-                samples.check("force derivative ∂f/∂u", e.name(), &ws.gu)?;
-                samples.check("force derivative ∂f/∂u̇", e.name(), &ws.gdu)?;
-                self.aft
-                    .spectrum_into(&mut ws.gu, &mut ws.spec_u, &mut ws.aft);
-                self.aft
-                    .spectrum_into(&mut ws.gdu, &mut ws.spec_du, &mut ws.aft);
-                ws.ffts += 2;
-                let samples = self.basis.samples();
-                crate::harmonic::kinks::correct_spectrum(
-                    &mut ws.spec_u,
-                    samples,
-                    &ws.crossings,
-                    false,
-                );
-                crate::harmonic::kinks::correct_spectrum(
-                    &mut ws.spec_du,
-                    samples,
-                    &ws.crossings,
-                    true,
-                );
                 crate::jacobian::add_element_jacobian(
                     &ws.spec_u,
                     &ws.spec_du,
@@ -213,6 +222,35 @@ impl HarmonicBalance<'_> {
         if let Some(tail) = self.tail.as_deref().filter(|t| t.applies()) {
             tail.add_into(self, q, out, ws);
         }
+        Ok(())
+    }
+
+    /// The spectra of `∂f/∂u - k0`, `∂f/∂u̇ - d0` of `act` from its samples into `ws.spec_u`,
+    /// `ws.spec_du`, corrected at the crossings in `ws.crossings`.
+    fn element_spectra(
+        &self,
+        act: &ActiveElement,
+        lin: &crate::force::LinearPart,
+        name: &str,
+        ws: &mut AftBuffers,
+    ) -> Result<()> {
+        self.derivative_samples(act, ws);
+        for (g, d) in ws.gu.iter_mut().zip(ws.gdu.iter_mut()) {
+            *g -= lin.stiffness;
+            *d -= lin.damping;
+        }
+        let samples = self.samples(ws);
+        samples.check("force derivative ∂f/∂u", name, &ws.gu)?;
+        samples.check("force derivative ∂f/∂u̇", name, &ws.gdu)?;
+        self.aft
+            .spectrum_into(&mut ws.gu, &mut ws.spec_u, &mut ws.aft);
+        self.aft
+            .spectrum_into(&mut ws.gdu, &mut ws.spec_du, &mut ws.aft);
+        ws.ffts += 2;
+        let samples = self.basis.samples();
+        let correct = crate::harmonic::kinks::correct_spectrum;
+        correct(&mut ws.spec_u, samples, &ws.crossings, false);
+        correct(&mut ws.spec_du, samples, &ws.crossings, true);
         Ok(())
     }
 

@@ -16,7 +16,8 @@
 //!   elements, the factored `Z_k`), its accessors;
 //! - `workspace`: the per-solve buffers ([`Workspace`], [`AftBuffers`]);
 //! - `aft`: `F_rest(Q)` and its exact Jacobian by AFT, element by element (`memory` for laws
-//!   with memory, `located` to name a non-finite sample);
+//!   with memory, `exact_kinks` for laws affine on their pieces whose coordinate crosses a
+//!   kink, `located` to name a non-finite sample);
 //! - `real_form`: `R(x)` and `∂R/∂x` in the real layout, the Parseval norm;
 //! - `frequency`: a change of Ω (`Z_k` refactored), `∂R/∂Ω`, the scaling of the alternating load;
 //! - `condensed`: the condensed formulation (unknowns on the element coordinates);
@@ -30,6 +31,7 @@ use crate::model::Model;
 
 mod aft;
 mod condensed;
+mod exact_kinks;
 mod frequency;
 mod limits;
 mod located;

@@ -22,6 +22,13 @@ pub struct AftBuffers {
     pub(super) spec_du: Vec<Complex64>,
     pub(super) jac_scratch: crate::jacobian::JacobianScratch,
     pub(super) crossings: Vec<crate::harmonic::kinks::Crossing>,
+    /// Where the element coordinate crosses a kink.
+    pub(super) edges: Vec<crate::harmonic::kinks::EdgeCrossing>,
+    /// The breaks of a law affine on its pieces, and its coefficients' spectrum `E_m` and
+    /// samples (see [`crate::harmonic::kinks::exact`]).
+    pub(super) pieces: crate::harmonic::kinks::exact::PieceCoefficients,
+    pub(super) spec_e: Vec<Complex64>,
+    pub(super) ge: Vec<f64>,
     /// Sensitivities of the march of laws with memory (empty without them).
     pub(super) march: crate::harmonic::march::MarchBuffers,
     /// One local Jacobian column (laws with memory).
@@ -70,6 +77,13 @@ impl HarmonicBalance<'_> {
                 spec_du: vec![Complex64::default(); s / 2 + 1],
                 jac_scratch: crate::jacobian::JacobianScratch::new(h),
                 crossings: Vec::with_capacity(16),
+                edges: Vec::with_capacity(16),
+                pieces: crate::harmonic::kinks::exact::PieceCoefficients {
+                    breaks: Vec::with_capacity(64),
+                    ..Default::default()
+                },
+                spec_e: vec![Complex64::default(); s / 2 + 1],
+                ge: vec![0.0; s],
                 march: if self.trig.is_empty() {
                     Default::default()
                 } else {

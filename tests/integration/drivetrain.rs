@@ -2,6 +2,7 @@
 //! model, the full and the condensed formulation on the same periodic solution, closed-form
 //! static twists, and clear errors.
 
+use crate::common;
 use hbal::catalog::drivetrain::{GearPair, Shaft};
 use hbal::catalog::Drivetrain;
 use hbal::compare::relative_error;
@@ -138,7 +139,7 @@ fn firing_order_phases() {
 }
 
 /// Newton converges in both formulations at n = 30, H = 16 (teeth divided by 4: mesh
-/// harmonics 8, 8, 5, 3) and they agree to 1e-10; the condensation has one coordinate per
+/// harmonics 8, 8, 5, 3) and they agree to 3e-10; the condensation has one coordinate per
 /// mesh and the clutch.
 #[test]
 fn full_and_condensed_agree() {
@@ -156,7 +157,14 @@ fn full_and_condensed_agree() {
     let full = solve(&model, basis, Formulation::Full);
     let cond = solve(&model, basis, Formulation::Condensed);
     let diff = relative_error(cond.harmonics(), full.harmonics(), model.n_dofs(), h);
-    assert!(diff < 1e-10, "condensed against full {diff:.1e}");
+    // Both satisfy the exact Galerkin equations (2e-13, 3e-13 of the load); they differ by the
+    // conditioning of the stiff meshes times Newton's 1e-12 (1.1e-10).
+    for s in [&full, &cond] {
+        let galerkin = common::galerkin::residual_relative_to_load;
+        let r = galerkin(&model, basis.omega(), s.harmonics());
+        assert!(r < 1e-11, "{r:.1e}");
+    }
+    assert!(diff < 3e-10, "condensed against full {diff:.1e}");
     // The tip-relief contacts open and close: the solution is not the linear one.
     assert!(full.stats.iterations >= 2, "{}", full.stats.iterations);
 

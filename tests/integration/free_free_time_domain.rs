@@ -6,7 +6,7 @@
 use crate::common;
 
 use common::time_domain::{hb, time_domain_to};
-use hbal::compare::relative_error;
+use hbal::compare::{model_relative_error, relative_error};
 use hbal::scene::Scene;
 use std::path::Path;
 
@@ -21,8 +21,10 @@ fn free_free_drivetrain_matches_the_time_domain_over_the_speed_range() {
         let h = 256;
         let x = hb(&scene.model, omega, h);
         let td = time_domain_to(&scene.model, omega, &x, 1e-9);
-        let e = relative_error(&x, &td, scene.model.n_dofs(), 2 * h);
-        eprintln!("{rpm} rpm: {e:.2e}");
+        let e = model_relative_error(&scene.model, &x, &td, 2 * h);
+        // The rigid angle the time domain drifted to is a convention, not an error.
+        let with_rigid_mean = relative_error(&x, &td, scene.model.n_dofs(), 2 * h);
+        eprintln!("{rpm} rpm: {e:.2e} ({with_rigid_mean:.2e} with the rigid mean angle)");
         // The mesh stiffness jumps in time: <= 1e-4 (issue 11).
         assert!(e < 1e-4, "{rpm} rpm: {e:e}");
     }

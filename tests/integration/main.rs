@@ -22,6 +22,7 @@ mod cli_start_files;
 mod cli_sweep;
 mod condensation;
 mod condensation_branches;
+mod contact_quadrature;
 mod continuation;
 mod drivetrain;
 mod element_output;

@@ -214,15 +214,26 @@ pub(crate) fn derivatives(uk: &[Complex64], theta: f64) -> [f64; 4] {
     out
 }
 
+/// Where the element coordinate crosses a kink: the kink `κ`, the angle `θ*` (on the
+/// fundamental, in `[0, 2π)` up to rounding), the sample interval `j` with
+/// `θ_j <= θ* <= θ_{j+1}` and the slope `u'(θ*)` (per radian of θ).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeCrossing {
+    /// The kink `κ` crossed.
+    pub kappa: f64,
+    /// `θ*`.
+    pub theta: f64,
+    /// The sample interval `j`.
+    pub sample: usize,
+    /// `u'(θ*)`.
+    pub slope: f64,
+}
+
 /// The crossings of the kinks `kinks` by the element coordinate with samples `u` and `du`
 /// (its time derivative) at `θ_j = 2π j / N` and harmonics `uk`, with the jumps of the force
-/// of `law` there, appended to `out`. `fundamental` is the Ω/ν that turns θ-derivatives into
-/// time derivatives, `nu` the ν that turns θ into the law's shaft angle.
-///
-/// A crossing shows as a change of side between two samples; two crossings inside one sample
-/// interval (the coordinate grazes the edge and comes back) show as an extremum there (`du`
-/// changes sign) beyond the edge, and are found as well, so the residual stays continuous when
-/// a contact opens or closes between samples.
+/// of `law` there, appended to `out` (allocates; the AFT calls [`find_edge_crossings`] and
+/// [`crossing_jumps`] on its own buffers). `fundamental` is the Ω/ν that turns θ-derivatives
+/// into time derivatives, `nu` the ν that turns θ into the law's shaft angle.
 #[allow(clippy::too_many_arguments)]
 pub fn find_crossings(
     law: &dyn ForceLaw,
@@ -234,12 +245,27 @@ pub fn find_crossings(
     nu: usize,
     out: &mut Vec<Crossing>,
 ) {
-    let n = u.len();
-    let h = TAU / n as f64;
-    let mut push = |kappa: f64, t: f64, j: usize| {
-        let d = derivatives(uk, t);
-        let alpha = ((t - j as f64 * h) / h).clamp(0.0, 1.0);
-        let c = jumps(law, kappa, t, alpha, d, fundamental, nu, h);
+    let mut edges = Vec::new();
+    find_edge_crossings(kinks, u, du, uk, fundamental, &mut edges);
+    crossing_jumps(law, &edges, uk, fundamental, nu, u.len(), out);
+}
+
+/// The jumps of the force of `law` at the crossings `edges` (from [`find_edge_crossings`] on
+/// `samples` samples), appended to `out`; crossings where a jump is not finite are left out.
+pub fn crossing_jumps(
+    law: &dyn ForceLaw,
+    edges: &[EdgeCrossing],
+    uk: &[Complex64],
+    fundamental: f64,
+    nu: usize,
+    samples: usize,
+    out: &mut Vec<Crossing>,
+) {
+    let h = TAU / samples as f64;
+    for e in edges {
+        let d = derivatives(uk, e.theta);
+        let alpha = ((e.theta - e.sample as f64 * h) / h).clamp(0.0, 1.0);
+        let c = jumps(law, e.kappa, e.theta, alpha, d, fundamental, nu, h);
         let finite = c
             .jumps
             .iter()
@@ -249,6 +275,35 @@ pub fn find_crossings(
         if finite {
             out.push(c);
         }
+    }
+}
+
+/// The crossings of the kinks `kinks` by the element coordinate with samples `u` and `du`
+/// (its time derivative) at `θ_j = 2π j / N` and harmonics `uk`, appended to `out`.
+/// `fundamental` is the Ω/ν that turns θ-derivatives into time derivatives.
+///
+/// A crossing shows as a change of side between two samples; two crossings inside one sample
+/// interval (the coordinate grazes the edge and comes back) show as an extremum there (`du`
+/// changes sign) beyond the edge, and are found as well, so the residual stays continuous when
+/// a contact opens or closes between samples.
+pub fn find_edge_crossings(
+    kinks: &[f64],
+    u: &[f64],
+    du: &[f64],
+    uk: &[Complex64],
+    fundamental: f64,
+    out: &mut Vec<EdgeCrossing>,
+) {
+    let n = u.len();
+    let h = TAU / n as f64;
+    let mut push = |kappa: f64, theta: f64, sample: usize| {
+        let slope = derivatives(uk, theta)[1];
+        out.push(EdgeCrossing {
+            kappa,
+            theta,
+            sample,
+            slope,
+        });
     };
     // Between samples `u` moves at most `h max |u_θ| ≤ h Σ k |u_k|`: a kink outside the
     // samples' range by more is neither crossed nor grazed.
@@ -404,6 +459,8 @@ fn jumps(
         ddu_jumps: [s * c[2], s * dt(2)],
     }
 }
+
+pub mod exact;
 
 #[cfg(test)]
 mod tests;

@@ -5,6 +5,7 @@
 
 pub mod cli;
 pub mod floquet;
+pub mod galerkin;
 pub mod hostile;
 pub mod time_domain;
 

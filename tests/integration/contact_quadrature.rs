@@ -1,0 +1,203 @@
+//! The AFT's quadrature across contact edges against an independent evaluation of the same
+//! Galerkin equations (`common::galerkin`: Gauss–Legendre on the pieces between the crossings):
+//! converged points satisfy the exact equations at their H to within 1e-9 of the load, for
+//! every built-in law with kinks.
+
+use crate::common::galerkin::residual_relative_to_load;
+use hbal::continuation::{BranchStop, Continuation};
+use hbal::force::{Backlash, ForceLaw, GapContact, MeshProfile, Offset, Stage, StopSpring};
+use hbal::scene::Scene;
+use hbal::{HarmonicBalance, HarmonicBasis, Model};
+use std::path::Path;
+
+/// NLvib's example 03 (`gap_contact`, stiffness 100, H = 21) swept from 0.8 to 0.5 through
+/// both folds: every converged point, in contact or not, within 1e-9 of the load (the
+/// Euler–Maclaurin correction left 4.5e-4 in contact).
+#[test]
+fn nlvib_03_points_satisfy_the_exact_galerkin_equations() {
+    let s = Scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/scenes/nlvib_03_unilateral_spring.toml"),
+    )
+    .unwrap();
+    let branch = Continuation {
+        stability: None,
+        tolerance: 1e-12,
+        ..Continuation::default()
+    }
+    .run(&s.model, s.basis, 0.5, |_| {})
+    .unwrap();
+    assert_eq!(branch.stop, BranchStop::Reached);
+    let mut worst: f64 = 0.0;
+    let mut in_contact = 0;
+    for p in branch.points.iter().step_by(3) {
+        let r = residual_relative_to_load(&s.model, p.omega, &p.harmonics);
+        in_contact += usize::from(p.max_abs[0] > 1.0);
+        worst = worst.max(r);
+    }
+    eprintln!(
+        "{} points, {in_contact} in contact, worst residual {worst:.2e}",
+        branch.points.len()
+    );
+    assert!(in_contact > 5, "{in_contact}");
+    assert!(worst < 1e-9, "{worst:e}");
+}
+
+/// `x'' + 0.05 x' + x + f(θ, x, x') = 0.3 + load cos θ` swept from Ω = 0.3 to `omega`: the
+/// largest residual of its Galerkin equations relative to the load over the branch.
+fn one_dof(law: impl ForceLaw + 'static, load: f64, omega: f64, h: usize) -> f64 {
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .damping(nalgebra::DMatrix::from_element(1, 1, 0.05))
+        .stiffness(nalgebra::DMatrix::from_element(1, 1, 1.0))
+        .element("contact", &[("x", 1.0)], law)
+        .load("x", 0, 0.3, 0.0)
+        .load("x", 1, load, 0.0)
+        .build()
+        .unwrap();
+    let branch = Continuation {
+        stability: None,
+        tolerance: 1e-12,
+        ..Continuation::default()
+    }
+    .run(&model, HarmonicBasis::new(0.3, h).unwrap(), omega, |_| {})
+    .unwrap();
+    assert_eq!(branch.stop, BranchStop::Reached);
+    // About 12 points spread over the branch.
+    let every = (branch.points.len() / 12).max(1);
+    branch
+        .points
+        .iter()
+        .step_by(every)
+        .map(|p| residual_relative_to_load(&model, p.omega, &p.harmonics))
+        .fold(0.0, f64::max)
+}
+
+/// Each law on a branch that opens and closes its contact (the Euler–Maclaurin correction
+/// left 1e-7 to 1e-4 on these; each case fails with it).
+#[test]
+fn every_builtin_law_with_kinks_is_exact_in_contact() {
+    let rectangular = MeshProfile::Rectangular {
+        one_tooth: 8.0,
+        two_tooth: 12.0,
+        contact_ratio: 1.4,
+    };
+    let stages = vec![
+        Stage {
+            from: 0.1,
+            stiffness: 2.0,
+        },
+        Stage {
+            from: 0.4,
+            stiffness: 30.0,
+        },
+    ];
+    type Case<'a> = (&'a str, Box<dyn Fn() -> f64>);
+    let cases: Vec<Case> = vec![
+        (
+            "gap_contact",
+            Box::new(|| one_dof(GapContact::new(0.5, 20.0), 0.15, 0.9, 16)),
+        ),
+        (
+            "gap_contact with damping and preload",
+            Box::new(|| {
+                let law = GapContact::new(-0.1, 2.0).with_contact_damping(0.4);
+                one_dof(law, 0.3, 1.3, 16)
+            }),
+        ),
+        (
+            "backlash, constant stiffness, contact damping",
+            Box::new(|| {
+                let law = Backlash::new(0.1, MeshProfile::Constant { stiffness: 10.0 })
+                    .with_contact_damping(0.2);
+                one_dof(law, 0.1, 3.2, 16)
+            }),
+        ),
+        (
+            "backlash, rectangular stiffness",
+            Box::new(move || {
+                let law = Backlash::new(0.1, rectangular.clone());
+                one_dof(law, 0.1, 1.0, 24)
+            }),
+        ),
+        (
+            "stop_spring",
+            Box::new(move || {
+                one_dof(
+                    StopSpring::new(stages.clone()).with_damping(0.02),
+                    0.1,
+                    1.6,
+                    16,
+                )
+            }),
+        ),
+        (
+            "offset gap_contact",
+            Box::new(|| one_dof(Offset::new(0.3, GapContact::new(0.2, 20.0)), 0.15, 0.9, 16)),
+        ),
+    ];
+    let mut failed = Vec::new();
+    for (name, case) in &cases {
+        let r = case();
+        eprintln!("{name}: {r:.2e}");
+        if r > 1e-9 {
+            failed.push(format!("{name}: {r:.2e}"));
+        }
+    }
+    assert!(failed.is_empty(), "{failed:?}");
+}
+
+/// The exact path's Jacobian is the derivative of its residual (central differences), with
+/// contact damping (a force jump whose crossing moves) and a rectangular stiffness.
+#[test]
+fn exact_jacobian_matches_central_differences() {
+    let rectangular = MeshProfile::Rectangular {
+        one_tooth: 8.0,
+        two_tooth: 12.0,
+        contact_ratio: 1.4,
+    };
+    let laws: Vec<Box<dyn ForceLaw>> = vec![
+        Box::new(GapContact::new(0.1, 20.0).with_contact_damping(0.4)),
+        Box::new(Backlash::new(0.2, rectangular).with_teeth(3)),
+    ];
+    for law in laws {
+        let name = format!("{law:?}");
+        let model = Model::builder(&["x"])
+            .mass_diagonal(&[1.0])
+            .damping(nalgebra::DMatrix::from_element(1, 1, 0.05))
+            .stiffness(nalgebra::DMatrix::from_element(1, 1, 1.0))
+            .element_boxed("contact", &[("x", 1.0)], law)
+            .build()
+            .unwrap();
+        let hb = HarmonicBalance::new(&model, HarmonicBasis::new(0.8, 8).unwrap()).unwrap();
+        let mut ws = hb.workspace();
+        let layout = hb.layout();
+        let m = layout.len();
+        // An orbit through both sides of every edge.
+        let mut q = vec![hbal::num_complex::Complex64::default(); 9];
+        q[0] = 0.15.into();
+        q[1] = hbal::num_complex::Complex64::new(0.5, -0.2);
+        q[2] = hbal::num_complex::Complex64::new(0.1, 0.05);
+        q[5] = hbal::num_complex::Complex64::new(-0.02, 0.03);
+        let mut x = vec![0.0; m];
+        layout.pack(&q, &mut x);
+        let mut r = vec![0.0; m];
+        let mut jac = nalgebra::DMatrix::zeros(m, m);
+        hb.residual_real_into(&x, &mut r, Some(&mut jac), &mut ws)
+            .unwrap();
+        let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
+        let mut worst: f64 = 0.0;
+        for col in 0..m {
+            let (mut xp, mut xm) = (x.clone(), x.clone());
+            xp[col] += 1e-7;
+            xm[col] -= 1e-7;
+            hb.residual_real_into(&xp, &mut rp, None, &mut ws).unwrap();
+            hb.residual_real_into(&xm, &mut rm, None, &mut ws).unwrap();
+            for i in 0..m {
+                worst = worst.max(((rp[i] - rm[i]) / 2e-7 - jac[(i, col)]).abs());
+            }
+        }
+        eprintln!("{name}: |J - FD| = {worst:.2e} of {:.2e}", jac.amax());
+        assert!(worst < 1e-6 * jac.amax(), "{name}: {worst:e}");
+    }
+}
