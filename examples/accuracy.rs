@@ -203,6 +203,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 match control {
                     Control::Solution => "periodic solution",
                     Control::Harmonics => "harmonics 0..H",
+                    Control::Quantities => "every DOF and element coordinate",
                 },
                 if a.capped { " (cap)" } else { "" },
                 wall.as_secs_f64() * 1e6,

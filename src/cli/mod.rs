@@ -29,6 +29,7 @@ pub(crate) mod element_report;
 pub(crate) mod modes;
 pub(crate) mod order_cuts;
 pub(crate) mod parameter_sweep;
+mod quantity_report;
 pub(crate) mod report;
 pub(crate) mod report_html;
 pub(crate) mod solve;
@@ -101,8 +102,10 @@ pub(crate) struct SolverArgs {
     pub(crate) method: Option<String>,
     /// Number of harmonics H, or `auto` to raise H until the estimated error is below the
     /// scene's `harmonics.tolerance` (default 1e-6) (default: the scene's). `auto:harmonics`
-    /// controls the error of the harmonics 0..H alone (order amplitudes), `auto:solution` that
-    /// of the periodic solution with the harmonics it lacks (the default).
+    /// controls the error of the harmonics 0..H alone (order amplitudes), `auto:quantities`
+    /// that of every DOF and element coordinate on its own (dynamic part against its own
+    /// range, peak values included), `auto:solution` that of the periodic solution with the
+    /// harmonics it lacks (the default).
     #[arg(long)]
     pub(crate) harmonics: Option<HarmonicsArg>,
     /// Number of time samples N per period, at least 2H+1 (default: the scene's, or the
@@ -133,11 +136,12 @@ impl std::str::FromStr for HarmonicsArg {
             "auto" => return Ok(HarmonicsArg::Auto(None)),
             "auto:solution" => return Ok(HarmonicsArg::Auto(Some(Control::Solution))),
             "auto:harmonics" => return Ok(HarmonicsArg::Auto(Some(Control::Harmonics))),
+            "auto:quantities" => return Ok(HarmonicsArg::Auto(Some(Control::Quantities))),
             _ => {}
         }
         s.parse::<usize>().map(HarmonicsArg::Count).map_err(|_| {
             format!(
-                "expected a whole number of harmonics, `auto`, `auto:harmonics` or `auto:solution`, got `{s}`"
+                "expected a whole number of harmonics, `auto`, `auto:harmonics`, `auto:quantities` or `auto:solution`, got `{s}`"
             )
         })
     }

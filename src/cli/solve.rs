@@ -56,6 +56,8 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let started = Instant::now();
     let solve_seconds;
     let mut exact = None;
+    // Automatic harmonics handed over to the exact piecewise solution at the cap.
+    let mut switched = false;
     let (sol, estimate, auto) = match scene.auto {
         Some(auto) => {
             if start.is_some() {
@@ -69,6 +71,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 .map_err(|e| super::failure(e, &scene.file))?;
             solve_seconds = started.elapsed().as_secs_f64();
             exact = a.exact;
+            switched = a.switched_to_exact;
             (
                 a.solution,
                 Some(Ok(a.estimate)),
@@ -178,13 +181,20 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         let doc = json!({
             "converged": sol.is_converged(),
             "termination": sol.termination.to_string(),
-            "method": scene.method.name(),
+            "method": if switched { "piecewise_exact" } else { scene.method.name() },
+            "switched_to_exact": switched,
             "iterations": sol.stats.iterations,
             "residual": sol.residual(),
             "truncation_estimate": sol.truncation_estimate(),
             "error_estimate": match &estimate {
                 None => serde_json::Value::Null,
-                Some(Ok(e)) => json!({"relative": e.relative, "kept_harmonics": e.kept_harmonics, "reference_harmonics": e.reference_harmonics, "lower_bound": e.lower_bound}),
+                Some(Ok(e)) => {
+                    let mut v = json!({"relative": e.relative, "kept_harmonics": e.kept_harmonics, "reference_harmonics": e.reference_harmonics, "lower_bound": e.lower_bound});
+                    if let (Some(o), serde_json::Value::Object(q)) = (v.as_object_mut(), super::quantity_report::estimate_fields(&scene.model, e)) {
+                        o.extend(q);
+                    }
+                    v
+                }
                 Some(Err(e)) => json!({"error": e}),
             },
             "auto_harmonics": auto.as_ref().map(|(a, levels, capped)| json!({
@@ -218,7 +228,11 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             "{}: {} ({}) after {} iteration{}{}, relative residual {:.2e}, solve {:.3} ms",
             scene.file,
             sol.termination,
-            scene.method.name(),
+            if switched {
+                "piecewise_exact"
+            } else {
+                scene.method.name()
+            },
             sol.stats.iterations,
             if sol.stats.iterations == 1 { "" } else { "s" },
             if start.is_some() && exact.is_none() {
@@ -236,12 +250,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             sol.basis().samples(),
             match &estimate {
                 Some(Ok(e)) => format!(
-                    "error estimate {}{:.1e}, of harmonics 0..{} {:.1e} (against H = {})",
+                    "error estimate {}{:.1e}, of harmonics 0..{} {:.1e} (against H = {}){}",
                     if e.lower_bound { "at least " } else { "" },
                     e.relative,
                     sol.basis().harmonics(),
                     e.kept_harmonics,
-                    e.reference_harmonics
+                    e.reference_harmonics,
+                    super::quantity_report::summary(&scene.model, e)
                 ),
                 Some(Err(e)) => format!("no error estimate: {e}"),
                 None => "no error estimate (not converged)".to_string(),
@@ -259,6 +274,12 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 if *capped { " (NOT reached)" } else { "" },
                 steps.join(", ")
             );
+            if switched {
+                say!(
+                    "  harmonic balance stopped at the cap H = {} above the tolerance; the scene is linear with piecewise-constant coefficients, so the exact piecewise solution answers instead (the levels after the cap are its own): its harmonics 0..H are exact, its time series and extremes come from its closed form in time",
+                    a.max_harmonics
+                );
+            }
         }
         if let Some(x) = &extremes {
             say!(

@@ -15,7 +15,7 @@ pub(super) struct Harmonics {
     auto: bool,
     tolerance: Option<f64>,
     max: Option<usize>,
-    /// What `auto` controls: `"solution"` (default) or `"harmonics"`.
+    /// What `auto` controls: `"solution"` (default), `"quantities"` or `"harmonics"`.
     control: Option<crate::solve::Control>,
     /// The tail correction of jumping coefficients (default: off at a fixed H, on with
     /// `auto`; see [`HarmonicBasis::with_tail_correction`]).

@@ -18,7 +18,8 @@
 //! a message. The estimate is the whole solution's by default, or that of its harmonics
 //! `0..=H` alone ([`Control`]).
 
-use crate::compare::relative_error;
+use crate::compare::quantities::{quantity_errors, worst};
+use crate::compare::{relative_error, QuantityError};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::residual::HarmonicBalance;
@@ -45,6 +46,15 @@ pub struct ErrorEstimate {
     /// budget): the true error may be larger.
     #[serde(default)]
     pub lower_bound: bool,
+    /// The worst DOF or element coordinate, each by its dynamic part relative to its own
+    /// range ([`crate::compare::quantities`]), against the same finer solution: what
+    /// [`Control::Quantities`] controls. `None` where not estimated.
+    #[serde(default)]
+    pub worst_quantity: Option<QuantityError>,
+    /// The worst element force the same way (a force that jumps where a contact with damping
+    /// closes is only as good as the crossing's position).
+    #[serde(default)]
+    pub worst_force: Option<QuantityError>,
 }
 
 /// The basis with `harmonics` harmonics at the Ω and ν of `basis`, with as many samples per
@@ -128,14 +138,32 @@ pub fn estimate_error(model: &Model, solution: &Solution) -> Result<ErrorEstimat
         });
     }
     let fine = refine(model, solution, Formulation::Auto)?;
-    Ok(compare(solution, &fine, model.n_dofs()))
+    Ok(compare(model, solution, &fine))
 }
 
 /// The estimate of `coarse` against `fine`: relative distances over `0..=2H` and `0..=H`,
-/// floored at 1e-15 (two solutions that agree to rounding do not make an error of zero).
-fn compare(coarse: &Solution, fine: &Solution, n: usize) -> ErrorEstimate {
+/// and per quantity, floored at 1e-15 (two solutions that agree to rounding do not make an
+/// error of zero).
+fn compare(model: &Model, coarse: &Solution, fine: &Solution) -> ErrorEstimate {
+    let n = model.n_dofs();
     let (h, h2) = (coarse.basis().harmonics(), fine.basis().harmonics());
+    let errors = quantity_errors(
+        model,
+        fine.basis(),
+        coarse.harmonics(),
+        fine.harmonics(),
+        fine.basis().samples(),
+    )
+    .unwrap_or_default();
+    let floored = |e: Option<QuantityError>| {
+        e.map(|e| QuantityError {
+            error: e.error.max(FLOOR),
+            ..e
+        })
+    };
     ErrorEstimate {
+        worst_quantity: floored(worst(&errors, |q| q.is_motion())),
+        worst_force: floored(worst(&errors, |q| !q.is_motion())),
         relative: relative_error(coarse.harmonics(), fine.harmonics(), n, h2).max(FLOOR),
         kept_harmonics: relative_error(coarse.harmonics(), fine.harmonics(), n, h).max(FLOOR),
         reference_harmonics: h2,
@@ -154,6 +182,10 @@ pub enum Control {
     /// ([`ErrorEstimate::relative`]): the time signal, its extremes and max |q|. The default.
     #[default]
     Solution,
+    /// Every DOF and element coordinate on its own, by its dynamic part relative to its own
+    /// range ([`ErrorEstimate::worst_quantity`]): the transmission error of a gear stage is
+    /// controlled even where the static wind-up of the shafts dominates the whole solution.
+    Quantities,
     /// Its harmonics `0..=H` alone ([`ErrorEstimate::kept_harmonics`]): order amplitudes and
     /// phases, the order cuts of a run-up. A jumping mesh stiffness leaves the harmonics above
     /// H with content that decays like H^-2.5, so the whole solution needs many more
@@ -163,22 +195,31 @@ pub enum Control {
 }
 
 impl Control {
-    /// `solution` or `harmonics`, whichever this control names.
+    /// `solution` or `harmonics`, whichever this control names (`solution` for the
+    /// quantities: they include what the solution lacks above H).
     pub fn pick<T>(self, solution: T, harmonics: T) -> T {
         match self {
-            Control::Solution => solution,
+            Control::Solution | Control::Quantities => solution,
             Control::Harmonics => harmonics,
         }
     }
 
-    /// The controlled part of `estimate`.
+    /// The controlled part of `estimate` (the whole solution's where the quantities were
+    /// not estimated).
     pub fn of(self, estimate: &ErrorEstimate) -> f64 {
-        self.pick(estimate.relative, estimate.kept_harmonics)
+        match (self, estimate.worst_quantity) {
+            (Control::Quantities, Some(q)) => q.error,
+            _ => self.pick(estimate.relative, estimate.kept_harmonics),
+        }
     }
 
-    /// What is controlled, in words: "the periodic solution" or "the harmonics 0..H".
+    /// What is controlled, in words.
     pub fn what(self) -> &'static str {
-        self.pick("the periodic solution", "the harmonics 0..H")
+        match self {
+            Control::Solution => "the periodic solution",
+            Control::Quantities => "every DOF and element coordinate",
+            Control::Harmonics => "the harmonics 0..H",
+        }
     }
 }
 
@@ -231,8 +272,14 @@ pub struct AutoSolution {
     /// `true` if the tolerance was not reached by `max_harmonics`.
     pub capped: bool,
     /// The exact piecewise solution at the chosen H where the method is
-    /// [`Method::PiecewiseExact`] (its closed form in time, its multipliers).
+    /// [`Method::PiecewiseExact`] (its closed form in time, its multipliers), or where harmonic
+    /// balance could not reach the tolerance by the cap and the exact method could
+    /// (`switched_to_exact`).
     pub exact: Option<crate::solve::piecewise::ExactSolution>,
+    /// `true` where harmonic balance stopped at the cap above the tolerance and the model
+    /// admits the exact piecewise solution, which reached it: `solution` is that one, and
+    /// `levels` holds harmonic balance's levels and then the exact method's.
+    pub switched_to_exact: bool,
 }
 
 /// Solves `model` at H = H0, 2 H0, ... from `basis` (its Ω, its H as H0 and its samples per
@@ -283,7 +330,6 @@ pub fn solve_auto(
     if let Method::PiecewiseExact(exact) = method {
         return auto_exact(model, basis, exact, auto);
     }
-    let n = model.n_dofs();
     let mut level_basis = scaled(&basis, basis.harmonics().max(1))?;
     let started = Instant::now();
     let mut hb = HarmonicBalance::with_formulation(model, level_basis, auto.formulation)?;
@@ -301,7 +347,7 @@ pub fn solve_auto(
             });
         }
         let fine = refine(model, &current, auto.formulation)?;
-        let estimate = compare(&current, &fine, n);
+        let estimate = compare(model, &current, &fine);
         levels.push(Level {
             harmonics: level_basis.harmonics(),
             samples: level_basis.samples(),
@@ -310,6 +356,11 @@ pub fn solve_auto(
         });
         let reached = auto.control.of(&estimate) <= auto.tolerance;
         let capped = !reached && fine.basis().harmonics() > auto.max_harmonics;
+        if capped {
+            if let Some(exact) = exact_instead(model, basis, auto, &levels) {
+                return Ok(exact);
+            }
+        }
         if reached || capped {
             return Ok(AutoSolution {
                 solution: current,
@@ -317,11 +368,40 @@ pub fn solve_auto(
                 levels,
                 capped,
                 exact: None,
+                switched_to_exact: false,
             });
         }
         level_basis = *fine.basis();
         current = fine;
     }
+}
+
+/// Where harmonic balance stopped at the cap with its levels `hb_levels` above the tolerance:
+/// the exact piecewise solution from `basis` (the first level), if the model admits the
+/// method and its harmonics `0..=H` reach the tolerance; else `None`. Its time series and
+/// extremes come from its closed form in time, so what its harmonics lack above H (a stiffness
+/// jump ringing at a natural frequency far above the orders) is no error of theirs.
+fn exact_instead(
+    model: &Model,
+    basis: HarmonicBasis,
+    auto: AutoHarmonics,
+    hb_levels: &[Level],
+) -> Option<AutoSolution> {
+    let exact = crate::solve::PiecewiseExact::default();
+    crate::solve::PiecewiseExact::check(model).ok()?;
+    let harmonics = AutoHarmonics {
+        control: Control::Harmonics,
+        ..auto
+    };
+    let mut found = auto_exact(model, basis, &exact, harmonics).ok()?;
+    if found.capped {
+        return None;
+    }
+    let mut levels = hb_levels.to_vec();
+    levels.append(&mut found.levels);
+    found.levels = levels;
+    found.switched_to_exact = true;
+    Some(found)
 }
 
 /// [`solve_auto`] with the exact piecewise solution: its harmonics `0..=H` are exact, so only
@@ -357,6 +437,7 @@ fn auto_exact(
                 levels,
                 capped,
                 exact: Some(e),
+                switched_to_exact: false,
             });
         }
         level_basis = scaled(&level_basis, next)?;

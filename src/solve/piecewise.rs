@@ -264,6 +264,8 @@ impl PiecewiseExact {
             kept_harmonics: rounding,
             reference_harmonics: orders * nu,
             lower_bound,
+            worst_quantity: None,
+            worst_force: None,
         };
         // The exact solution has harmonics above H: an element's force from the kept ones
         // balances the equation of motion only with the tail correction's part (see

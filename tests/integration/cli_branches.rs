@@ -250,16 +250,21 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
         assert!((1e-15..=1e-6).contains(&kept), "{kept}");
         assert!(doc["error_estimate"]["relative"].as_f64().unwrap() > 1e-4);
     }
-    // `auto:solution` overrides it: capped at H = 64, exit 1, the message says which error.
+    // `auto:solution` overrides it: harmonic balance stops at the cap H = 64 above the
+    // tolerance, and the scene, linear with piecewise-constant coefficients, gets the exact
+    // piecewise solution instead (exit 0), which says so.
     let (out, doc) = solve(Some("auto:solution"));
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(0));
     assert_eq!(doc["auto_harmonics"]["control"], "solution");
-    assert_eq!(doc["harmonics"], 64);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("of the periodic solution") && err.contains("at the cap H = 64"),
-        "{err}"
-    );
+    assert_eq!(doc["method"], "piecewise_exact");
+    assert_eq!(doc["switched_to_exact"], true);
+    assert_eq!(doc["harmonics"], 32);
+    let levels = doc["auto_harmonics"]["levels"].as_array().unwrap();
+    assert_eq!(levels[1]["harmonics"], 64);
+    assert!(levels[1]["estimate"].as_f64().unwrap() > 1e-6);
+    let text = hbal(&["solve", p.to_str().unwrap(), "--no-stability", "--harmonics", "auto:solution"]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("the exact piecewise solution answers instead"), "{text}");
     // A sweep checks the estimate it controls along the branch: no warning here.
     let out = hbal(&[
         "sweep",

@@ -1,4 +1,8 @@
-//! Distances between periodic solutions given by their harmonics.
+//! Distances between periodic solutions given by their harmonics: over all DOFs (here) and
+//! per quantity ([`quantities`]).
+
+pub mod quantities;
+pub use quantities::{quantity_errors, Quantity, QuantityError};
 
 use num_complex::Complex64;
 

@@ -1,0 +1,46 @@
+//! The per-quantity error estimate as the CLI prints it: the worst DOF or element coordinate
+//! and the worst element force, each by name and relative to its own range.
+
+use hbal::compare::QuantityError;
+use hbal::solve::ErrorEstimate;
+use hbal::Model;
+use serde_json::{json, Value};
+
+/// `{"name", "quantity", "error", "range"}` of one quantity, or null.
+pub(crate) fn quantity_json(model: &Model, q: Option<QuantityError>) -> Value {
+    match q {
+        Some(q) => json!({
+            "name": q.quantity.name(model),
+            "quantity": q.quantity,
+            "error": q.error,
+            "range": q.range,
+        }),
+        None => Value::Null,
+    }
+}
+
+/// `worst_quantity` and `worst_force` of `e` as JSON fields.
+pub(crate) fn estimate_fields(model: &Model, e: &ErrorEstimate) -> Value {
+    json!({
+        "worst_quantity": quantity_json(model, e.worst_quantity),
+        "worst_force": quantity_json(model, e.worst_force),
+    })
+}
+
+/// `"; worst quantity u(mesh) 1.8e-2 of its range 4.1e-5, force f(mesh) 2.2e-2"`, or
+/// nothing where the quantities were not estimated.
+pub(crate) fn summary(model: &Model, e: &ErrorEstimate) -> String {
+    let mut out = String::new();
+    if let Some(q) = e.worst_quantity {
+        out += &format!(
+            "; worst quantity {} {:.1e} of its range {:.3e}",
+            q.quantity.name(model),
+            q.error,
+            q.range
+        );
+    }
+    if let Some(f) = e.worst_force {
+        out += &format!(", force {} {:.1e}", f.quantity.name(model), f.error);
+    }
+    out
+}
