@@ -20,7 +20,8 @@ mod run;
 mod start;
 
 pub use accuracy::{
-    estimate_error, solve_auto, AutoHarmonics, AutoSolution, Control, ErrorEstimate, Level,
+    estimate_error, refined_solution, solve_auto, AutoHarmonics, AutoSolution, Control,
+    ErrorEstimate, Level,
 };
 pub use anderson::{Anderson, AndersonSolver};
 pub use broyden::{Broyden, BroydenSolver, InitialJacobian};

@@ -262,9 +262,18 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
     let levels = doc["auto_harmonics"]["levels"].as_array().unwrap();
     assert_eq!(levels[1]["harmonics"], 64);
     assert!(levels[1]["estimate"].as_f64().unwrap() > 1e-6);
-    let text = hbal(&["solve", p.to_str().unwrap(), "--no-stability", "--harmonics", "auto:solution"]);
+    let text = hbal(&[
+        "solve",
+        p.to_str().unwrap(),
+        "--no-stability",
+        "--harmonics",
+        "auto:solution",
+    ]);
     let text = String::from_utf8_lossy(&text.stdout);
-    assert!(text.contains("the exact piecewise solution answers instead"), "{text}");
+    assert!(
+        text.contains("the exact piecewise solution answers instead"),
+        "{text}"
+    );
     // A sweep checks the estimate it controls along the branch: no warning here.
     let out = hbal(&[
         "sweep",

@@ -43,6 +43,11 @@ fn condensed_equals_full_on_the_example_scenes() {
             .basis
             .harmonics()
             .min(32.max(orders.max().unwrap_or(0)));
+        // The car drivetrain's mesh at harmonic 851 is beyond the full formulation's dense
+        // Newton (tests/integration/car_drivetrain.rs covers it).
+        if scene.model.n_dofs() * (2 * h + 1) > hbal::solve::MAX_DENSE_UNKNOWNS {
+            continue;
+        }
         let basis = HarmonicBasis::new(scene.basis.omega(), h)
             .unwrap()
             .with_subharmonic(scene.basis.subharmonic())

@@ -13,6 +13,7 @@ mod aft;
 mod bad_input;
 mod band_limited;
 mod branch_switching;
+mod car_drivetrain;
 mod cli;
 mod cli_auto_harmonics;
 mod cli_branches;
