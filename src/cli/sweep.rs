@@ -322,6 +322,20 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 }
             );
         }
+        let worst_quantity = branch
+            .points
+            .iter()
+            .filter_map(|p| p.worst_quantity.map(|q| (q, p.omega)))
+            .max_by(|a, b| a.0.error.total_cmp(&b.0.error));
+        if let Some((q, w)) = worst_quantity {
+            say!(
+                "  worst quantity {} {:.1e} of its range {:.3e} (at {:.6} {unit}; dynamic part, with what H lacks)",
+                q.quantity.name(&scene.model),
+                q.error,
+                q.range,
+                speed(w)
+            );
+        }
         let failed_start = matches!(branch.stop, BranchStop::StartFailed { .. });
         if !branch.start.is_empty() && branch.start != scene.method.name() && !failed_start {
             say!("  first point: {}", branch.start);

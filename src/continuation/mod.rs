@@ -59,6 +59,10 @@ pub struct BranchPoint {
     /// ([`ErrorEstimate::kept_harmonics`](crate::solve::ErrorEstimate::kept_harmonics)).
     #[serde(default)]
     pub error_estimate_harmonics: Option<f64>,
+    /// The worst DOF or element coordinate by its dynamic part against its own range
+    /// ([`ErrorEstimate::worst_quantity`](crate::solve::ErrorEstimate::worst_quantity)).
+    #[serde(default)]
+    pub worst_quantity: Option<crate::compare::QuantityError>,
     /// Floquet multipliers, if computed.
     pub floquet: Option<Floquet>,
     /// A turning point of the branch lies between the previous point and this one, confirmed

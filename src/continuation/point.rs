@@ -132,6 +132,7 @@ impl Continuation {
         let finite = |e: f64| Some(e).filter(|e| e.is_finite());
         let error_estimate = estimate.and_then(|e| finite(e.relative));
         let error_estimate_harmonics = estimate.and_then(|e| finite(e.kept_harmonics));
+        let worst_quantity = estimate.and_then(|e| e.worst_quantity);
         let residual = sol.residual();
         branch.points.push(BranchPoint {
             parameter: p.parameter,
@@ -142,6 +143,7 @@ impl Continuation {
             truncation,
             error_estimate,
             error_estimate_harmonics,
+            worst_quantity,
             floquet,
             // Set by the caller for a turn, then [`classify_turns`] decides once the
             // neighbours are known.
