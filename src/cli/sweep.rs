@@ -66,6 +66,56 @@ fn run(
     continuation.run_from(model, basis, to, initial, progress)
 }
 
+/// The branch with automatic harmonics held along it ([`Continuation::run_auto`]) as one
+/// branch on the last segment's basis (returned): the segments' points in order, each padded
+/// with zeros to the last H (exact: a point has no content above its own H), the last
+/// segment's stop, and a note of where H rose.
+fn run_auto(
+    continuation: &Continuation,
+    scene: &hbal::scene::Scene,
+    basis: HarmonicBasis,
+    to: f64,
+    initial: &[Complex64],
+    auto: hbal::solve::AutoHarmonics,
+    bar: &indicatif::ProgressBar,
+) -> Result<(Branch, HarmonicBasis), Failure> {
+    let mut segments = continuation
+        .run_auto(&scene.model, basis, to, Some(initial), auto, |f| {
+            bar.set_position((f * 1000.0) as u64)
+        })
+        .map_err(|e| super::sweep_failure(e, &scene.file))?;
+    let mut branch = segments.remove(0);
+    let mut steps = vec![format!("H = {}", branch.harmonics)];
+    for s in segments {
+        if let hbal::continuation::BranchStop::HarmonicsRaised { omega, harmonics } = branch.stop {
+            steps.push(format!("H = {harmonics} from {omega:.6} rad/s"));
+        }
+        branch.points.extend(s.points);
+        branch.stop = s.stop;
+    }
+    if steps.len() > 1 {
+        eprintln!("note: harmonics along the branch: {}", steps.join(", "));
+    }
+    let n = branch.dofs.len();
+    let top = branch
+        .points
+        .iter()
+        .map(|p| p.harmonics.len() / n.max(1))
+        .max()
+        .unwrap_or(1)
+        .saturating_sub(1);
+    for p in &mut branch.points {
+        p.harmonics.resize((top + 1) * n, Complex64::default());
+    }
+    let ratio = top.max(1) as f64 / basis.harmonics().max(1) as f64;
+    let last = HarmonicBasis::new(basis.omega(), top)?
+        .with_tail_correction_of(&basis)
+        .with_subharmonic(basis.subharmonic())?
+        .with_samples(((basis.samples() as f64 * ratio).ceil() as usize).max(4 * top + 1))?;
+    branch.harmonics = top;
+    Ok((branch, last))
+}
+
 pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
     let as_json = opts.json || opts.capture.is_some();
     let (to, out, max_step) = (opts.to, opts.out, opts.max_step);
@@ -143,19 +193,26 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         .with_tail_correction_of(&scene.basis)
         .with_samples(scene.basis.samples())
         .with_context(|| scene.file.clone())?;
-    // Automatic harmonics: H chosen at the first speed, then kept along the branch.
+    // Automatic harmonics: H chosen at the first speed, then raised along the branch where a
+    // point exceeds the tolerance (kept with --all-branches, whose switching needs one H).
+    let mut auto_start = None;
     if let Some(auto) = scene.auto {
         let a = hbal::solve::solve_auto(&scene.model, basis, &scene.method, auto)
             .map_err(|e| super::failure(e, &scene.file))?;
         basis = *a.solution.basis();
+        let raised = !opts.all_branches && a.exact.is_none() && !a.capped;
         eprintln!(
-            "note: harmonics: auto, tolerance {:.0e}{}: H = {} (error estimate {:.1e} at {from} {unit}{}), kept along the branch",
+            "note: harmonics: auto, tolerance {:.0e}{}: H = {} (error estimate {:.1e} at {from} {unit}{}), {}",
             auto.tolerance,
             auto.control.pick("", " on the harmonics 0..H"),
             basis.harmonics(),
             auto.control.of(&a.estimate),
-            if a.capped { ", above the tolerance at the cap" } else { "" }
+            if a.capped { ", above the tolerance at the cap" } else { "" },
+            if raised { "raised along the branch where a point exceeds the tolerance" } else { "kept along the branch" }
         );
+        if raised {
+            auto_start = Some((auto, a.solution.harmonics().to_vec()));
+        }
     }
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
@@ -182,16 +239,23 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         ..defaults
     };
     let started = Instant::now();
-    let branch = run(
-        &continuation,
-        &scene.model,
-        basis,
-        to * per,
-        start.as_ref().map(|s| s.harmonics.as_slice()),
-        opts.points,
-        |f| bar.set_position((f * 1000.0) as u64),
-    )
-    .map_err(|e| super::sweep_failure(e, &scene.file))?;
+    let branch = match &auto_start {
+        Some((auto, q)) => {
+            let (branch, last) = run_auto(&continuation, &scene, basis, to * per, q, *auto, &bar)?;
+            basis = last;
+            branch
+        }
+        None => run(
+            &continuation,
+            &scene.model,
+            basis,
+            to * per,
+            start.as_ref().map(|s| s.harmonics.as_slice()),
+            opts.points,
+            |f| bar.set_position((f * 1000.0) as u64),
+        )
+        .map_err(|e| super::sweep_failure(e, &scene.file))?,
+    };
     let (lo, hi) = (from.min(to) * per, from.max(to) * per);
     let secondary = if opts.all_branches {
         bar.set_message("switching branches");

@@ -19,6 +19,7 @@
 //! points so far) when it falls under its minimum.
 
 mod arclength;
+mod auto_harmonics;
 mod bordered;
 mod locate;
 mod parameter;
@@ -156,6 +157,15 @@ pub enum BranchStop {
         /// The solver's termination.
         reason: String,
     },
+    /// Automatic harmonics ([`Continuation::run_auto`]): the point at this Ω exceeded the
+    /// tolerance, and the branch goes on from it with `harmonics` harmonics in the next
+    /// segment (a normal end of this one).
+    HarmonicsRaised {
+        /// Where.
+        omega: f64,
+        /// The next segment's H.
+        harmonics: usize,
+    },
 }
 
 impl std::fmt::Display for BranchStop {
@@ -170,6 +180,12 @@ impl std::fmt::Display for BranchStop {
                 write!(f, "singular bordered system near Ω = {omega}")
             }
             BranchStop::SwitchFailed { reason } => write!(f, "no branch switch: {reason}"),
+            BranchStop::HarmonicsRaised { omega, harmonics } => {
+                write!(
+                    f,
+                    "goes on with H = {harmonics} from Ω = {omega} (automatic harmonics)"
+                )
+            }
             BranchStop::Rejoined { omega } => {
                 write!(f, "rejoined the parent branch near Ω = {omega}")
             }
@@ -247,7 +263,10 @@ impl BranchStop {
     /// `true` for a normal end: the end of the range, or (a switched branch) back on its
     /// parent.
     pub fn is_normal_end(&self) -> bool {
-        matches!(self, BranchStop::Reached | BranchStop::Rejoined { .. })
+        matches!(
+            self,
+            BranchStop::Reached | BranchStop::Rejoined { .. } | BranchStop::HarmonicsRaised { .. }
+        )
     }
 }
 

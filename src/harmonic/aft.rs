@@ -93,13 +93,20 @@ impl AftPlan {
     }
 
     /// Writes `x_j = Σ_{|m|<=M} c_m e^{imθ_j}` (`c_{-m} = conj c_m`) into `out` (length N)
-    /// from the normalised coefficients `c_m = bins[m]`, `m = 0..=M` (`M < N/2`, the
+    /// from the normalised coefficients `c_m = bins[m]`, `m = 0..=M` (`M <= N/2`, the
     /// inverse of [`AftPlan::spectrum_into`] for a band-limited signal).
     pub fn synthesize_bins_into(&self, bins: &[Complex64], out: &mut [f64], s: &mut AftScratch) {
         s.spectrum.fill(Complex64::default());
-        let top = bins.len().min(s.spectrum.len() - 1);
+        let top = bins.len().min(s.spectrum.len());
         s.spectrum[..top].copy_from_slice(&bins[..top]);
         s.spectrum[0].im = 0.0;
+        // For even N the last bin is the Nyquist bin, which must be real (with M < N/2, as
+        // the exact contact path has, it is empty).
+        if self.basis.samples() % 2 == 0 {
+            if let Some(last) = s.spectrum.last_mut() {
+                last.im = 0.0;
+            }
+        }
         let _ = self
             .inverse
             .process_with_scratch(&mut s.spectrum, out, &mut s.scratch);

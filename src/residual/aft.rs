@@ -174,6 +174,11 @@ impl HarmonicBalance<'_> {
                 exact = act.exact_pieces
                     && !ws.edges.is_empty()
                     && self.exact_kinks_into(act, e.law(), &lin, ws);
+                if exact {
+                    ws.exact_contacts += 1;
+                } else if !ws.edges.is_empty() {
+                    ws.approximate_contacts += 1;
+                }
                 if !exact {
                     crate::harmonic::kinks::crossing_jumps(
                         law,

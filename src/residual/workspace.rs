@@ -39,6 +39,13 @@ pub struct AftBuffers {
     pub ffts: usize,
     /// Force-law calls so far.
     pub force_evaluations: usize,
+    /// Element evaluations whose contact crossings were integrated exactly (a law affine on
+    /// its pieces, see [`crate::harmonic::kinks::exact`]) so far.
+    pub exact_contacts: usize,
+    /// Element evaluations with contact crossings that took the corrected trapezoid rule
+    /// instead (other laws, fewer than 4H + 1 samples, or a law that did not agree with its
+    /// pieces along the orbit) so far.
+    pub approximate_contacts: usize,
 }
 
 /// Per-solve buffers: no allocation happens while iterating.
@@ -93,6 +100,8 @@ impl HarmonicBalance<'_> {
                 tail: self.tail.as_ref().map(|t| t.buffers()).unwrap_or_default(),
                 ffts: 0,
                 force_evaluations: 0,
+                exact_contacts: 0,
+                approximate_contacts: 0,
             },
             q: vec![Complex64::default(); len],
             rest: vec![Complex64::default(); len],

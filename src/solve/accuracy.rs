@@ -409,8 +409,9 @@ pub fn solve_auto(
 }
 
 /// Where harmonic balance stopped at the cap with its levels `hb_levels` above the tolerance:
-/// the exact piecewise solution from `basis` (the first level), if the model admits the
-/// method and its harmonics `0..=H` reach the tolerance; else `None`. Its time series and
+/// the exact piecewise solution on the basis of the last level (the H a sweep or comparison
+/// then uses), if the model admits the method and its harmonics `0..=H` reach the tolerance;
+/// else `None`. Its time series and
 /// extremes come from its closed form in time, so what its harmonics lack above H (a stiffness
 /// jump ringing at a natural frequency far above the orders) is no error of theirs.
 fn exact_instead(
@@ -425,6 +426,8 @@ fn exact_instead(
         control: Control::Harmonics,
         ..auto
     };
+    let last = hb_levels.last().map_or(basis.harmonics(), |l| l.harmonics);
+    let basis = scaled(&basis, last).ok()?;
     let mut found = auto_exact(model, basis, &exact, harmonics).ok()?;
     if found.capped {
         return None;

@@ -258,7 +258,7 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
     assert_eq!(doc["auto_harmonics"]["control"], "solution");
     assert_eq!(doc["method"], "piecewise_exact");
     assert_eq!(doc["switched_to_exact"], true);
-    assert_eq!(doc["harmonics"], 32);
+    assert_eq!(doc["harmonics"], 64);
     let levels = doc["auto_harmonics"]["levels"].as_array().unwrap();
     assert_eq!(levels[1]["harmonics"], 64);
     assert!(levels[1]["estimate"].as_f64().unwrap() > 1e-6);

@@ -385,3 +385,48 @@ fn a_parameter_sweep_of_the_speed_solves_at_each_speed() {
         "{amplitudes:?}"
     );
 }
+
+/// Automatic harmonics held along a sweep: the backlash pair with forcing 0.1 from 1.6 down to
+/// 0.44 rad/s starts at H = 8 and raises H where the contact opens (16, 32, 64), so no point
+/// exceeds the tolerance (before: H = 8 kept, estimates up to 4.2e-3 and a warning).
+#[test]
+fn sweep_raises_harmonics_along_the_branch() {
+    let text = std::fs::read_to_string(scenes_dir().join("gear_backlash.toml"))
+        .unwrap()
+        .replace(
+            "{ dof = \"x\", order = 1, cos = 0.05 }",
+            "{ dof = \"x\", order = 1, cos = 0.1 }",
+        )
+        .replace(
+            "harmonics = { count = 32 }",
+            "harmonics = { auto = true, count = 8, tolerance = 1e-6 }",
+        )
+        .replace("rad_s = 0.7", "rad_s = 1.6");
+    assert!(text.contains("auto = true") && text.contains("cos = 0.1 }"));
+    let p = std::env::temp_dir().join(format!("hbal-auto-sweep-{}.toml", std::process::id()));
+    std::fs::write(&p, text).unwrap();
+    let out = hbal(&[
+        "sweep",
+        p.to_str().unwrap(),
+        "--to",
+        "0.44",
+        "--no-stability",
+        "--json",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("harmonics along the branch: H = 8, H = 16 from"),
+        "{err}"
+    );
+    assert!(!err.contains("warning"), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let worst = doc["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|p| p["error_estimate"].as_f64())
+        .fold(0.0, f64::max);
+    assert!(worst > 0.0 && worst <= 1e-6, "{worst:e}");
+    std::fs::remove_file(&p).ok();
+}

@@ -199,5 +199,98 @@ fn exact_jacobian_matches_central_differences() {
         }
         eprintln!("{name}: |J - FD| = {worst:.2e} of {:.2e}", jac.amax());
         assert!(worst < 1e-6 * jac.amax(), "{name}: {worst:e}");
+        let b = ws.aft_buffers();
+        assert!(
+            b.exact_contacts > 0 && b.approximate_contacts == 0,
+            "{name}"
+        );
+    }
+}
+
+/// The exact path's harmonics against the independent evaluation at odd N = 4H + 1 (the
+/// order-2H bin is an ordinary one there) and on a period-2 basis (ν = 2: the law sees twice
+/// the basis angle), on orbits that cross both edges of a backlash with a rectangular
+/// stiffness and contact damping.
+#[test]
+fn exact_harmonics_at_odd_samples_and_on_a_period_two_basis() {
+    use hbal::num_complex::Complex64;
+    let rectangular = MeshProfile::Rectangular {
+        one_tooth: 8.0,
+        two_tooth: 12.0,
+        contact_ratio: 1.4,
+    };
+    let law = Backlash::new(0.1, rectangular).with_contact_damping(0.3);
+    let lin = law.linear_part();
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .element("contact", &[("x", 1.0)], law.clone())
+        .build()
+        .unwrap();
+    let h = 8;
+    let omega = 0.9;
+    for (samples, nu) in [(4 * h + 1, 1), (4 * h + 2, 1), (64, 2)] {
+        let basis = HarmonicBasis::new(omega, h)
+            .unwrap()
+            .with_subharmonic(nu)
+            .unwrap()
+            .with_samples(samples)
+            .unwrap();
+        let hb = HarmonicBalance::new(&model, basis).unwrap();
+        let mut ws = hb.workspace();
+        let mut q = vec![Complex64::default(); h + 1];
+        q[0] = 0.05.into();
+        q[nu] = Complex64::new(0.3, -0.1);
+        q[2 * nu] = Complex64::new(0.04, 0.02);
+        q[1] += Complex64::new(0.01, 0.0);
+        let mut out = vec![Complex64::default(); h + 1];
+        hb.rest_into(&q, &mut out, ws.aft_buffers()).unwrap();
+        assert!(ws.aft_buffers().exact_contacts > 0);
+        // The law on the fundamental Ω/ν: its angle θ_shaft = ν θ. Evaluate a copy that
+        // takes the basis angle.
+        let fundamental = omega / nu as f64;
+        let on_basis = OnBasis {
+            law: law.clone(),
+            nu: nu as f64,
+        };
+        let exact = crate::common::galerkin::force_harmonics(&on_basis, &q, fundamental, h);
+        let mut worst: f64 = 0.0;
+        for k in 0..=h {
+            let kw = k as f64 * fundamental;
+            let l = q[k] * Complex64::new(lin.stiffness, kw * lin.damping)
+                + if k == 0 { lin.offset } else { 0.0 };
+            worst = worst.max((out[k] + l - exact[k]).norm());
+        }
+        eprintln!("N = {samples}, ν = {nu}: {worst:.2e}");
+        assert!(worst < 1e-12, "N = {samples}, ν = {nu}: {worst:e}");
+    }
+}
+
+/// A law seen on the basis angle: `law(ν θ, u, u̇)`, for the independent evaluation.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+struct OnBasis {
+    law: Backlash,
+    nu: f64,
+}
+
+#[typetag::serde(name = "test_on_basis")]
+impl ForceLaw for OnBasis {
+    fn force(&self, theta: f64, u: f64, du: f64) -> f64 {
+        self.law
+            .force((self.nu * theta).rem_euclid(std::f64::consts::TAU), u, du)
+    }
+    fn derivatives(&self, theta: f64, u: f64, du: f64) -> (f64, f64) {
+        self.law
+            .derivatives((self.nu * theta).rem_euclid(std::f64::consts::TAU), u, du)
+    }
+    fn kinks(&self) -> Vec<f64> {
+        self.law.kinks()
+    }
+    fn time_breakpoints(&self) -> Vec<f64> {
+        let nu = self.nu as usize;
+        self.law
+            .time_breakpoints()
+            .iter()
+            .flat_map(|b| (0..nu).map(move |r| (b + std::f64::consts::TAU * r as f64) / nu as f64))
+            .collect()
     }
 }

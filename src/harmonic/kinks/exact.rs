@@ -49,7 +49,7 @@ pub struct Break {
 pub struct PieceCoefficients {
     /// The breaks, sorted by angle.
     pub breaks: Vec<Break>,
-    /// `θ_r` (between the first two breaks) and `(A, B, E)` there.
+    /// `θ_r` (in the middle of the widest gap between breaks) and `(A, B, E)` there.
     pub reference: (f64, [f64; 3]),
 }
 
@@ -116,12 +116,26 @@ impl PieceCoefficients {
                 pulse: 0.0,
             });
         }
-        self.breaks.sort_by(|a, b| a.theta.total_cmp(&b.theta));
-        let Some(first) = self.breaks.first() else {
+        self.breaks
+            .sort_unstable_by(|a, b| a.theta.total_cmp(&b.theta));
+        if self.breaks.is_empty() {
             return false;
-        };
-        let next = self.breaks.get(1).map_or(first.theta + TAU, |b| b.theta);
-        let theta_r = 0.5 * (first.theta + next);
+        }
+        // The reference point in the middle of the widest gap between breaks (round the
+        // circle): far from every break, so its side is no matter of rounding.
+        let len = self.breaks.len();
+        let (mut theta_r, mut widest) = (0.0, -1.0);
+        for i in 0..len {
+            let a = self.breaks[i].theta;
+            let b = if i + 1 < len {
+                self.breaks[i + 1].theta
+            } else {
+                self.breaks[0].theta + TAU
+            };
+            if b - a > widest {
+                (theta_r, widest) = ((0.5 * (a + b)).rem_euclid(TAU), b - a);
+            }
+        }
         let d = derivatives(uk, theta_r);
         let value = coefficients(law, shaft(theta_r), d[0], fundamental * d[1]);
         self.reference = (theta_r, value);
@@ -193,7 +207,7 @@ impl PieceCoefficients {
         let top = max_order.min(a.len() - 1);
         let mut total = [0.0; 3];
         let mut mean = value;
-        for br in &self.breaks {
+        for br in self.breaks.iter().filter(|b| b.jumps != [0.0; 3]) {
             let moved = if br.theta > theta_r {
                 br.theta
             } else {
