@@ -171,6 +171,29 @@ pub fn highest_natural_frequency(model: &Model) -> Option<f64> {
     lambda.is_finite().then(|| lambda.max(0.0).sqrt())
 }
 
+/// The undamped normal modes of `(M, K0)`: natural frequencies (rad/s) and M-normalised mode
+/// shapes (columns); `None` if `M` is not positive definite.
+pub(crate) struct NormalModes {
+    pub(crate) frequencies: Vec<f64>,
+    pub(crate) shapes: nalgebra::DMatrix<f64>,
+}
+
+/// [`NormalModes`] of `model` by a dense symmetric eigenproblem of `L⁻¹ K0 L⁻ᵀ`, `M = L Lᵀ`.
+pub(crate) fn normal_modes(model: &Model) -> Option<NormalModes> {
+    let dense = model.dense("normal modes").ok()?;
+    let chol = dense.mass.cholesky()?;
+    let l = chol.l();
+    let a = l.solve_lower_triangular(&dense.k0)?;
+    let b = l.solve_lower_triangular(&a.transpose())?;
+    let eig = ((&b + b.transpose()) * 0.5).symmetric_eigen();
+    let shapes = l.transpose().solve_upper_triangular(&eig.eigenvectors)?;
+    let frequencies = eig.eigenvalues.iter().map(|l| l.max(0.0).sqrt()).collect();
+    Some(NormalModes {
+        frequencies,
+        shapes,
+    })
+}
+
 /// The coarse harmonics for the two-level map on `basis`: every harmonic up to 1.5 times
 /// the highest natural frequency of `(M, K0)` (above it, `Z_k` dominates the coupling and the
 /// per-harmonic step contracts), at least 32 and every order of the model, at most

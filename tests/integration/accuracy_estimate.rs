@@ -237,6 +237,17 @@ fn automatic_harmonics_switch_to_the_exact_method_at_the_cap() {
         max_harmonics: 64,
         ..AutoHarmonics::default()
     };
+    // At H = 32 the mesh mode (harmonic 890) is beyond the 2H the estimate looks at: a lower
+    // bound; at 6000 rpm (mesh mode at harmonic 9) it is not.
+    let at_32 = solve(&model, omega, 32, &[]);
+    assert!(estimate_error(&model, &at_32).unwrap().lower_bound);
+    let fast = TwoShaft::new(6000.0);
+    let at_6000 = solve(&fast.model().unwrap(), fast.mesh_omega(), 32, &[]);
+    assert!(
+        !estimate_error(&fast.model().unwrap(), &at_6000)
+            .unwrap()
+            .lower_bound
+    );
     let a = solve_auto(&model, basis, &Method::Newton(Newton::new()), auto).unwrap();
     assert!(a.switched_to_exact && !a.capped);
     assert!(a.exact.is_some());
