@@ -408,8 +408,22 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     }
     let capped = matches!(&auto, Some((_, _, true)));
     if let Some((a, levels, true)) = &auto {
+        // The quantity that limits it, where the estimate has one.
+        let limiting = match &estimate {
+            Some(Ok(e)) => e
+                .worst_quantity
+                .map(|q| {
+                    format!(
+                        "; worst quantity {} {:.1e} of its range",
+                        q.quantity.name(&scene.model),
+                        q.error
+                    )
+                })
+                .unwrap_or_default(),
+            _ => String::new(),
+        };
         eprintln!(
-            "error: {}: automatic harmonics: the estimated error of {} {:.1e} is above the tolerance {:.0e} at the cap H = {} (harmonics.max)",
+            "error: {}: automatic harmonics: the estimated error of {} {:.1e} is above the tolerance {:.0e} at the cap H = {} (harmonics.max){limiting}",
             scene.file,
             a.control.what(),
             levels.last().map_or(f64::NAN, |l| l.estimate),

@@ -291,7 +291,10 @@ fn automatic_harmonics_on_the_command_line_and_in_scenes() {
     // A cap below what the tolerance needs: the last level, exit 1 and a message.
     let out = scene("harmonics = { auto = true, count = 1, tolerance = 1e-12, max = 2 }");
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("at the cap H = 2"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("at the cap H = 2"), "{err}");
+    // ... naming the quantity that limits it.
+    assert!(err.contains("; worst quantity "), "{err}");
     for (bad, field) in [
         (
             "harmonics = { auto = true, tolerance = 0.0 }",
