@@ -25,7 +25,7 @@
 //! pulse `[f]/u'(θ*)` at `θ*` in `∂f/∂u` ([`super::correct_spectrum`] explains it).
 //!
 //! The interface of a law does not say that it is affine on its pieces. The AFT asks
-//! [`crate::force::affine`] once per element, and [`PieceCoefficients::agrees_with`] checks
+//! `crate::force::affine` once per element, and [`PieceCoefficients::agrees_with`] checks
 //! every sample of every evaluation against the law before the result is used.
 
 use super::{derivatives, EdgeCrossing};
