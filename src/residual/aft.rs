@@ -176,10 +176,8 @@ impl HarmonicBalance<'_> {
                     && self.exact_kinks_into(act, e.law(), &lin, ws);
                 if exact {
                     ws.exact_contacts += 1;
-                } else if !ws.edges.is_empty() {
-                    ws.approximate_contacts += 1;
-                }
-                if !exact {
+                } else {
+                    ws.approximate_contacts += usize::from(!ws.edges.is_empty());
                     crate::harmonic::kinks::crossing_jumps(
                         law,
                         &ws.edges,

@@ -160,15 +160,22 @@ pub const MAX_COARSE_UNKNOWNS: usize = 640;
 /// The highest undamped natural frequency `ω_max` (rad/s) of `(M, K0)`: `√λ_max` of
 /// `L⁻¹ K0 L⁻ᵀ` with `M = L Lᵀ`; `None` if `M` is not positive definite.
 pub fn highest_natural_frequency(model: &Model) -> Option<f64> {
-    let dense = model.dense("natural frequencies").ok()?;
-    let chol = dense.mass.cholesky()?;
-    let l = chol.l();
-    let k0 = dense.k0;
-    let a = l.solve_lower_triangular(&k0)?;
-    let b = l.solve_lower_triangular(&a.transpose())?;
-    let sym = (&b + b.transpose()) * 0.5;
+    let (_, sym) = mass_normalised_stiffness(model)?;
     let lambda = sym.symmetric_eigenvalues().max();
     lambda.is_finite().then(|| lambda.max(0.0).sqrt())
+}
+
+/// `M = L Lᵀ` and `L⁻¹ K0 L⁻ᵀ` (symmetrised) of `model`; `None` if `M` is not positive
+/// definite.
+fn mass_normalised_stiffness(
+    model: &Model,
+) -> Option<(nalgebra::DMatrix<f64>, nalgebra::DMatrix<f64>)> {
+    let dense = model.dense("natural frequencies").ok()?;
+    let l = dense.mass.cholesky()?.l();
+    let a = l.solve_lower_triangular(&dense.k0)?;
+    let b = l.solve_lower_triangular(&a.transpose())?;
+    let sym = (&b + b.transpose()) * 0.5;
+    Some((l, sym))
 }
 
 /// The undamped normal modes of `(M, K0)`: natural frequencies (rad/s) and M-normalised mode
@@ -180,12 +187,8 @@ pub(crate) struct NormalModes {
 
 /// [`NormalModes`] of `model` by a dense symmetric eigenproblem of `L⁻¹ K0 L⁻ᵀ`, `M = L Lᵀ`.
 pub(crate) fn normal_modes(model: &Model) -> Option<NormalModes> {
-    let dense = model.dense("normal modes").ok()?;
-    let chol = dense.mass.cholesky()?;
-    let l = chol.l();
-    let a = l.solve_lower_triangular(&dense.k0)?;
-    let b = l.solve_lower_triangular(&a.transpose())?;
-    let eig = ((&b + b.transpose()) * 0.5).symmetric_eigen();
+    let (l, sym) = mass_normalised_stiffness(model)?;
+    let eig = sym.symmetric_eigen();
     let shapes = l.transpose().solve_upper_triangular(&eig.eigenvectors)?;
     let frequencies = eig.eigenvalues.iter().map(|l| l.max(0.0).sqrt()).collect();
     Some(NormalModes {

@@ -45,32 +45,11 @@ fn contact_damping_sweeps_in_a_few_points() {
     assert!(branch.points.len() < 60, "{} points", branch.points.len());
     // The Jacobian against central differences of the corrected residual.
     let hb = HarmonicBalance::new(&model, HarmonicBasis::new(0.9, 16).unwrap()).unwrap();
-    let mut ws = hb.workspace();
     let layout = hb.layout();
-    let m = layout.len();
-    let mut x = vec![0.0; m];
+    let mut x = vec![0.0; layout.len()];
     layout.pack(&branch.points.last().unwrap().harmonics, &mut x);
-    let mut r = vec![0.0; m];
-    let mut jac = nalgebra::DMatrix::zeros(m, m);
-    hb.residual_real_into(&x, &mut r, Some(&mut jac), &mut ws)
-        .unwrap();
-    let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
-    let mut worst: f64 = 0.0;
-    for col in 0..m {
-        let (mut xp, mut xm) = (x.clone(), x.clone());
-        xp[col] += 1e-6;
-        xm[col] -= 1e-6;
-        hb.residual_real_into(&xp, &mut rp, None, &mut ws).unwrap();
-        hb.residual_real_into(&xm, &mut rm, None, &mut ws).unwrap();
-        for i in 0..m {
-            worst = worst.max(((rp[i] - rm[i]) / 2e-6 - jac[(i, col)]).abs());
-        }
-    }
-    assert!(
-        worst < 1e-5 * jac.amax(),
-        "|J - FD| = {worst:e}, |J| = {}",
-        jac.amax()
-    );
+    let (worst, amax) = crate::common::jacobian_against_differences(&hb, &x, 1e-6);
+    assert!(worst < 1e-5 * amax, "|J - FD| = {worst:e}, |J| = {amax}");
 }
 
 /// The correction does not depend on the units of the coordinate: the pair with backlash,

@@ -43,3 +43,31 @@ pub fn hbal(args: &[&str]) -> std::process::Output {
         .output()
         .expect("run hbal")
 }
+
+/// `(max |J - FD|, max |J|)`: the residual's Jacobian at the real unknowns `x` of `hb`
+/// against central differences with step `step`.
+pub fn jacobian_against_differences(
+    hb: &hbal::HarmonicBalance,
+    x: &[f64],
+    step: f64,
+) -> (f64, f64) {
+    let mut ws = hb.workspace();
+    let m = x.len();
+    let mut r = vec![0.0; m];
+    let mut jac = nalgebra::DMatrix::zeros(m, m);
+    hb.residual_real_into(x, &mut r, Some(&mut jac), &mut ws)
+        .unwrap();
+    let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
+    let mut worst: f64 = 0.0;
+    for col in 0..m {
+        let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+        xp[col] += step;
+        xm[col] -= step;
+        hb.residual_real_into(&xp, &mut rp, None, &mut ws).unwrap();
+        hb.residual_real_into(&xm, &mut rm, None, &mut ws).unwrap();
+        for i in 0..m {
+            worst = worst.max(((rp[i] - rm[i]) / (2.0 * step) - jac[(i, col)]).abs());
+        }
+    }
+    (worst, jac.amax())
+}
