@@ -167,6 +167,9 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             (None, _) => serde_json::Value::Null,
             (Some(Ok(f)), _) => json!({
                 "stable": f.is_stable(),
+                "orbit": f.orbit,
+                "orbit_distance": f.orbit_distance,
+                "other_orbit": f.other_orbit,
                 "max_abs": f.max_abs(),
                 "multipliers": multipliers_json(f),
                 "moduli": f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>(),
@@ -320,6 +323,16 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                     String::new()
                 },
                 stability_seconds * 1e3
+            ),
+            Some(Ok(f)) if f.other_orbit.is_some() => say!(
+                "  stability: {}, max |μ| = {} ({} multiplier{}, {} neutral), {:.1} ms; shooting from the HB orbit found another periodic orbit {:.1e} of the dynamic range away (a strongly unstable orbit single shooting cannot hold): the multipliers are the HB orbit's own",
+                if f.is_stable() { "stable" } else { "unstable" },
+                super::modulus(f.max_abs()),
+                f.multipliers.len(),
+                if f.multipliers.len() == 1 { "" } else { "s" },
+                f.neutral,
+                stability_seconds * 1e3,
+                f.other_orbit.unwrap_or_default(),
             ),
             Some(Ok(f)) => say!(
                 "  stability: {}, max |μ| = {} ({} multiplier{}, {} neutral), orbit correction {:.1e}{}, {:.1} ms",

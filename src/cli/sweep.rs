@@ -337,10 +337,14 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 String::new()
             }
         );
-        if let Some(line) = super::sweep_summary::orbit_line(&branch) {
+        let orbits = super::sweep_summary::orbit_lines(&branch, unit, speed);
+        for line in &orbits {
             say!("  {line}");
-        } else if let Some(hint) = super::sweep_summary::orbit_hint(&branch) {
-            say!("  {hint}");
+        }
+        if orbits.is_empty() {
+            if let Some(hint) = super::sweep_summary::orbit_hint(&branch) {
+                say!("  {hint}");
+            }
         }
         if let Some(e) = scene.model.memory_element().filter(|_| opts.stability) {
             say!(
@@ -421,6 +425,19 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 _ => unreachable!("filtered"),
             };
             say!("  {what}, max |q| = {:.6e}", p.max_abs[0]);
+        }
+        for (p, e) in branch
+            .points
+            .iter()
+            .filter(|p| p.spurious_turn)
+            .filter_map(|p| p.turn_evidence.map(|e| (p, e)))
+        {
+            let text = |w: f64| format!("{} {unit}", super::speed_text(speed(w)));
+            say!(
+                "  turn at {} not a fold: {}",
+                text(p.fold_omega.unwrap_or(p.omega)),
+                e.describe(&text)
+            );
         }
         for b in &secondary {
             say!("  {}", secondary_line(b, unit, speed));

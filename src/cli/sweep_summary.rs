@@ -43,6 +43,13 @@ pub(crate) fn point_json(
         "polished": f.map(|f| f.polished),
         "stability_orbit": f.map(|f| f.orbit),
         "orbit_difference": f.and_then(|f| f.orbit_difference),
+        "orbit_distance": f.map(|f| f.orbit_distance),
+        "other_orbit": f.and_then(|f| f.other_orbit),
+        "turn_evidence": p.turn_evidence.map(|e| json!({
+            "before_speed": speed(e.before.0), "before_real_above_one": e.before.1,
+            "after_speed": speed(e.after.0), "after_real_above_one": e.after.1,
+            "turns": e.turns,
+        })),
         "harmonics": reported.iter().filter(|&&i| i < n).map(|&i| (0..=branch.harmonics).map(|k| {
             let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
             let shaft_order = super::element_report::order_of(k, fundamental_order, nu);
@@ -55,26 +62,50 @@ pub(crate) fn point_json(
     })
 }
 
-/// The summary line of the HB orbit's stability ([`Orbit::Harmonic`]): how many points have
-/// the HB orbit's multipliers and the largest difference to the exact orbit's measured on the
-/// way; `None` where every point has the exact orbit's.
-pub(crate) fn orbit_line(branch: &Branch) -> Option<String> {
-    let harmonic: Vec<f64> = branch
-        .points
-        .iter()
-        .filter_map(|p| p.floquet.as_ref())
-        .filter(|f| f.orbit == Orbit::Harmonic)
-        .map(|f| f.orbit_difference.unwrap_or(f64::NAN))
+/// The summary lines of the orbits the multipliers belong to: where the shooting found another
+/// periodic orbit than the point's (the HB orbit's own multipliers instead, or the stability
+/// unknown), and how many points have the HB orbit's multipliers ([`Orbit::Harmonic`]) with
+/// the largest difference to the exact orbit's measured on the way. Empty where every point
+/// has its exact orbit's.
+pub(crate) fn orbit_lines(branch: &Branch, unit: &str, speed: impl Fn(f64) -> f64) -> Vec<String> {
+    let mut lines = Vec::new();
+    let floquets = || {
+        branch
+            .points
+            .iter()
+            .filter_map(|p| p.floquet.as_ref().map(|f| (p, f)))
+    };
+    let other: Vec<(f64, f64)> = floquets()
+        .filter_map(|(p, f)| f.other_orbit.map(|d| (speed(p.omega), d)))
         .collect();
-    if harmonic.is_empty() {
-        return None;
+    if !other.is_empty() {
+        let (lo, hi) = other
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), o| {
+                (a.min(o.0), b.max(o.0))
+            });
+        let farthest = other.iter().map(|o| o.1).fold(0.0, f64::max);
+        lines.push(format!(
+            "shooting from the HB orbit found another periodic orbit at {} point{} between {} and {} {unit} (up to {farthest:.1e} of the dynamic range away, with multipliers of another kind: a strongly unstable orbit single shooting cannot hold): their multipliers are the HB orbit's own",
+            other.len(),
+            if other.len() == 1 { "" } else { "s" },
+            super::speed_text(lo),
+            super::speed_text(hi),
+        ));
     }
-    let largest = harmonic.iter().copied().fold(0.0, f64::max);
-    Some(format!(
-        "stability of the HB orbit at {} of {} points (the others the exact orbit's); multipliers within {largest:.1e} of the exact orbit's where measured",
-        harmonic.len(),
-        branch.points.len()
-    ))
+    let harmonic: Vec<f64> = floquets()
+        .filter(|(_, f)| f.orbit == Orbit::Harmonic && f.other_orbit.is_none())
+        .map(|(_, f)| f.orbit_difference.unwrap_or(f64::NAN))
+        .collect();
+    if !harmonic.is_empty() {
+        let largest = harmonic.iter().copied().fold(0.0, f64::max);
+        lines.push(format!(
+            "stability of the HB orbit at {} of {} points (the others the exact orbit's); multipliers within {largest:.1e} of the exact orbit's where measured",
+            harmonic.len(),
+            branch.points.len()
+        ));
+    }
+    lines
 }
 
 /// A hint for a long sweep of a large model (a reduced basis) with the exact orbit's

@@ -29,6 +29,7 @@ mod speed_homotopy;
 mod switch;
 
 pub use parameter::{parameter_sweep, sweep_values};
+pub use point::TurnEvidence;
 pub use speed_homotopy::solve_robustly;
 
 use crate::solve::{Method, Newton};
@@ -75,6 +76,10 @@ pub struct BranchPoint {
     /// few samples at a contact kink). Not a bifurcation.
     #[serde(default)]
     pub spurious_turn: bool,
+    /// For a turn (a fold or a spurious turn): what decided it, the real multipliers above +1
+    /// on both sides.
+    #[serde(default)]
+    pub turn_evidence: Option<TurnEvidence>,
     /// Its Ω, interpolated from the tangents at both points (Ω'(s) linear in arclength).
     pub fold_omega: Option<f64>,
     /// Stability changed between the previous point and this one, with this kind of

@@ -22,6 +22,51 @@ use crate::stability::{Bifurcation, FloquetOptions};
 use crate::HarmonicBasis;
 use num_complex::Complex64;
 
+/// Why a turning point of the discretised branch is a fold or not: a multiplier crosses +1
+/// between two orbits exactly where the number of real multipliers above +1 changes parity.
+/// Turns and parity changes close together form one cluster (a zig-zag near a fold of a
+/// non-smooth branch); the cluster is compared from the point two before it to the point
+/// after it.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TurnEvidence {
+    /// Ω of the point before the cluster, and its real multipliers above +1 (`None` if its
+    /// stability is unknown).
+    pub before: (f64, Option<usize>),
+    /// The same after the cluster.
+    pub after: (f64, Option<usize>),
+    /// Turns in the cluster (only its first can be the fold).
+    pub turns: usize,
+}
+
+impl TurnEvidence {
+    /// The reason in words, with `speed` formatting an Ω.
+    pub fn describe(&self, speed: &dyn Fn(f64) -> String) -> String {
+        let side = |(w, c): (f64, Option<usize>)| match c {
+            Some(c) => format!("{c} at {}", speed(w)),
+            None => format!("unknown at {}", speed(w)),
+        };
+        let counts = format!(
+            "real multipliers above +1: {} and {}",
+            side(self.before),
+            side(self.after)
+        );
+        let cluster = if self.turns > 1 {
+            format!(", {} turns close together", self.turns)
+        } else {
+            String::new()
+        };
+        match (self.before.1, self.after.1) {
+            (Some(a), Some(b)) if a % 2 == b % 2 => {
+                format!("{counts} (no multiplier crossed +1){cluster}")
+            }
+            (Some(_), Some(_)) => {
+                format!("{counts} (a multiplier crossed +1: the fold is the first turn){cluster}")
+            }
+            _ => format!("{counts} (decided by the number of turns){cluster}"),
+        }
+    }
+}
+
 /// What the caller knows about a new point.
 pub(super) struct NewPoint {
     /// The periodic solution (all DOFs) at the point's Ω.
@@ -71,7 +116,7 @@ impl Continuation {
         let sol = p.solution;
         let omega = sol.basis().omega();
         let prev = branch.points.last().and_then(|q| q.floquet.clone());
-        let prev_stable = prev.as_ref().map(|f| f.is_stable());
+        let prev_stable = branch.points.last().and_then(|q| q.stable());
         let (floquet, failure) = match &self.stability {
             Some(_) if p.floquet.is_some() => (p.floquet, None),
             // Laws with memory: stability unknown (see FloquetOptions::compute), the branch goes on.
@@ -149,6 +194,7 @@ impl Continuation {
             // neighbours are known.
             fold: false,
             spurious_turn: false,
+            turn_evidence: None,
             fold_omega: None,
             bifurcation,
             bifurcation_omega: None,
@@ -160,7 +206,8 @@ impl Continuation {
 /// Decides which tentative turns of `branch` are folds (module documentation).
 pub(super) fn classify_turns(branch: &mut Branch) {
     let pts = &mut branch.points;
-    let parity = |p: &BranchPoint| p.floquet.as_ref().map(|f| f.real_unstable() % 2);
+    let unstable = |p: &BranchPoint| p.floquet.as_ref().map(|f| f.real_unstable());
+    let parity = |p: &BranchPoint| unstable(p).map(|c| c % 2);
     // Events: tentative turns, and points whose parity differs from the previous point's.
     let mut events: Vec<(usize, bool)> = Vec::new();
     for i in 0..pts.len() {
@@ -200,10 +247,16 @@ pub(super) fn classify_turns(branch: &mut Branch) {
             (Some(a), Some(b)) => a != b,
             _ => turns.len() % 2 == 1,
         };
+        let evidence = TurnEvidence {
+            before: (pts[before].omega, unstable(&pts[before])),
+            after: (pts[after].omega, unstable(&pts[after])),
+            turns: turns.len(),
+        };
         for (j, &i) in turns.iter().enumerate() {
             let fold = confirmed && j == 0;
             pts[i].fold = fold;
             pts[i].spurious_turn = !fold;
+            pts[i].turn_evidence = Some(evidence);
             if !fold {
                 pts[i].fold_omega = None;
             }

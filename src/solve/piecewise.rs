@@ -150,6 +150,8 @@ impl ExactSolution {
             reduction: None,
             orbit: crate::stability::Orbit::Exact,
             orbit_difference: None,
+            orbit_distance: 0.0,
+            other_orbit: None,
         }
     }
 

@@ -9,7 +9,7 @@ use super::orbit_check::OrbitCheck;
 use super::reduction::{reduced_basis, ModeCache};
 use super::shooting::{distance, hb_start, shoot, Goal, Shot, Start};
 use super::system::Coordinates;
-use super::{Floquet, FloquetOptions, Orbit};
+use super::{Floquet, FloquetOptions, Orbit, OTHER_ORBIT_DISTANCE};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solution::Solution;
@@ -155,6 +155,9 @@ impl FloquetOptions {
             Orbit::Exact => self.exact_orbit(&sys, solution, cache, omega)?,
             Orbit::Harmonic => self.harmonic_orbit(&sys, solution, cache, omega)?,
         };
+        if floquet.other_orbit.is_some() && floquet.orbit == Orbit::Exact {
+            floquet = self.own_multipliers(&sys, solution, cache, floquet)?;
+        }
         if let Some(mut info) = reduction {
             if info.dofs >= n {
                 info.estimate = Some(0.0);
@@ -196,7 +199,10 @@ impl FloquetOptions {
                 jacobian,
                 &mut cache.generators,
             )?;
-            if s.floquet.polished && s.floquet.orbit_correction <= PREDICTED_ORBIT_DISTANCE {
+            if s.floquet.polished
+                && s.floquet.orbit_correction <= PREDICTED_ORBIT_DISTANCE
+                && s.floquet.orbit_distance <= OTHER_ORBIT_DISTANCE
+            {
                 shot = Some(s);
             }
         }
@@ -214,7 +220,18 @@ impl FloquetOptions {
                 &mut cache.generators,
             )?,
         };
-        let Shot { floquet, kappa, .. } = shot;
+        let Shot {
+            mut floquet, kappa, ..
+        } = shot;
+        let other = floquet.orbit_distance > OTHER_ORBIT_DISTANCE;
+        if other {
+            // Another orbit: its monodromy matrix and correction would lead the next points'
+            // shootings to it as well.
+            floquet.other_orbit = Some(floquet.orbit_distance);
+            cache.jacobian = None;
+            cache.corrections.clear();
+            return Ok(floquet);
+        }
         cache.kappa = kappa.or(cache.kappa);
         cache.jacobian = Some(shot.jacobian);
         let correction = floquet.polished.then(|| {

@@ -83,6 +83,8 @@ mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
 mod orbit_check;
+mod orbit_identity;
+pub use orbit_identity::{orbit_distance, OTHER_ORBIT_DISTANCE};
 mod pieces;
 mod pipeline;
 mod propagator;
@@ -161,6 +163,20 @@ pub struct Floquet {
     /// a single analysis measures its own); `None` for the exact orbit.
     #[serde(default)]
     pub orbit_difference: Option<f64>,
+    /// How far the start of the orbit the multipliers belong to lies from the HB state at
+    /// `t = 0`, in the HB orbit's dynamic terms ([`orbit_distance`]); 0 for the HB orbit's own
+    /// multipliers.
+    #[serde(default)]
+    pub orbit_distance: f64,
+    /// `Some(d)` where the shooting found another periodic orbit than the HB solution's: `d`
+    /// (more than [`OTHER_ORBIT_DISTANCE`]) away, also when started again from the HB state,
+    /// and with multipliers of another kind than the HB orbit's own (a strongly unstable
+    /// orbit single shooting cannot hold, whose neighbour it glided onto). The multipliers are
+    /// then the HB orbit's own ([`Orbit::Harmonic`]). Only where the HB orbit's pieces apply
+    /// (every law piecewise affine along it); elsewhere [`Floquet::orbit_distance`] says how
+    /// far the exact orbit lies.
+    #[serde(default)]
+    pub other_orbit: Option<f64>,
 }
 
 /// How often a sweep measures the HB orbit's multipliers against the exact orbit's
@@ -194,15 +210,18 @@ impl Floquet {
             .count()
     }
 
-    /// The kind of the critical multiplier (the one of largest modulus), by where it sits on
-    /// the unit circle: argument within 0.1 rad of 0 (fold), of π (period doubling), else
-    /// Neimark–Sacker.
+    /// The kind of the critical multiplier (the one of largest modulus): a complex pair is a
+    /// Neimark–Sacker point, also at a small argument (a pair at 1.054 ± 0.064i leaves the
+    /// circle as a pair, not through +1); a real one (or a pair within 1e-6 of the real axis,
+    /// rounding of a double root) is a fold by its argument within 0.1 rad of 0, a period
+    /// doubling within 0.1 rad of π.
     pub fn critical(&self) -> Option<Bifurcation> {
         let m = *self.multipliers.first()?;
         let angle = m.arg().abs();
-        Some(if angle < 0.1 {
+        let real = m.im.abs() <= 1e-6 * m.norm();
+        Some(if real && angle < 0.1 {
             Bifurcation::Fold
-        } else if angle > std::f64::consts::PI - 0.1 {
+        } else if real && angle > std::f64::consts::PI - 0.1 {
             Bifurcation::PeriodDoubling
         } else {
             Bifurcation::NeimarkSacker

@@ -15,6 +15,7 @@
 //! exact orbit's on the wider basis (both errors together).
 
 use super::dispatch::FloquetCache;
+use super::orbit_identity::same_kind;
 use super::shooting::{distance, shoot, Goal, Start};
 use super::system::Coordinates;
 use super::{Floquet, FloquetOptions, Integrator, Orbit, ORBIT_CHECK_EVERY, STABILITY_MARGIN};
@@ -78,7 +79,19 @@ impl FloquetOptions {
             floquet.orbit_difference = Some(check.distance);
             return Ok(floquet);
         }
-        let exact = exact.exact_orbit(sys, solution, cache, omega)?;
+        let mut exact = exact.exact_orbit(sys, solution, cache, omega)?;
+        if exact.other_orbit.is_some() && same_kind(&exact, &floquet) {
+            // Far, but the same kind of orbit: the HB solution is inaccurate.
+            exact.other_orbit = None;
+        }
+        if exact.other_orbit.is_some() {
+            // The shooting found another orbit: nothing to measure against, and the HB
+            // orbit's multipliers are the answer (measured again at the next point).
+            cache.orbit_check = None;
+            floquet.other_orbit = exact.other_orbit;
+            floquet.steps += exact.steps;
+            return Ok(floquet);
+        }
         // Reported: the larger of this and the last measurement (the difference is not
         // smooth in Ω: it follows the HB solution's error at the kinks).
         let measured = floquet.distance(&exact);

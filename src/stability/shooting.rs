@@ -211,6 +211,11 @@ pub(crate) fn shoot(
                 .as_slice(),
         )
     };
+    let orbit_distance = if harmonic {
+        0.0
+    } else {
+        super::orbit_distance(sys.model, solution, &hb_here, &orbit_start)
+    };
     let orbit_correction = (0..2 * n_model)
         .map(|i| (orbit_start[i] - hb_here[i]).abs() / full_scale(i))
         .fold(0.0, f64::max);
@@ -238,6 +243,8 @@ pub(crate) fn shoot(
                 Orbit::Exact
             },
             orbit_difference: None,
+            orbit_distance,
+            other_orbit: None,
         },
         kappa: outcome.kappa,
         ahead,

@@ -53,6 +53,7 @@ mod piecewise_exact;
 mod piecewise_exact_cli;
 mod reference_solutions;
 mod report;
+mod s_curve;
 mod scene_export;
 mod stability_at_scale;
 mod stability_exponential;

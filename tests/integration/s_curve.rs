@@ -1,0 +1,206 @@
+//! S-shaped run-ups through a mesh resonance with backlash: the middle branch unstable, both
+//! folds where a real multiplier crosses +1, and the labels checked by time integration from
+//! the reported orbits (the middle one is left, the outer ones stay).
+//!
+//! * `examples/scenes/single_stage_backlash_run_up.toml`: 6 DOFs, the mesh as the fundamental,
+//!   H = 32; the middle orbits' real multiplier is at most 2.5 per mesh period and shooting
+//!   finds them.
+//! * `tests/data/s_curve/car_drivetrain_stage2_frozen.toml` (release): the car drivetrain with
+//!   stage 2 frozen, the crank as the fundamental (23 mesh periods per period), H = 128. The
+//!   middle orbits' multiplier reaches 2e9 per period; shooting from them glided onto the upper
+//!   or lower branch's orbits, whose multipliers labelled the whole middle branch stable and
+//!   both turns spurious. The shooting's orbit is now told apart from the HB orbit
+//!   (`stability::orbit_distance`), and the HB orbit's own multipliers answer there.
+
+use hbal::continuation::{Branch, BranchPoint, Continuation};
+use hbal::scene::Scene;
+use hbal::timesim::TimeSimulation;
+use hbal::HarmonicBasis;
+use std::path::Path;
+
+fn sweep(file: &str, from_rpm: f64, to_rpm: f64) -> (Scene, Branch) {
+    let scene = Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap();
+    let per = scene.omega_per_speed;
+    let basis = HarmonicBasis::new(from_rpm * per, scene.basis.harmonics())
+        .unwrap()
+        .with_samples(scene.basis.samples())
+        .unwrap();
+    let cont = Continuation {
+        method: scene.method,
+        ..Continuation::default()
+    };
+    let branch = cont.run(&scene.model, basis, to_rpm * per, |_| {}).unwrap();
+    assert!(branch.stop.is_normal_end(), "{:?}", branch.stop);
+    (scene, branch)
+}
+
+/// The indices of the two folds, their speeds (rpm) and the checks common to both scenes:
+/// every point before the first fold and after the second stable (except `unstable_outer`
+/// points, a Neimark–Sacker window of the upper branch), every point between them unstable
+/// with a real multiplier above +1.
+fn folds(scene: &Scene, branch: &Branch, unstable_outer: usize) -> [(usize, f64); 2] {
+    let per = scene.omega_per_speed;
+    let folds: Vec<(usize, f64)> = (0..branch.points.len())
+        .filter(|&i| branch.points[i].fold)
+        .map(|i| (i, branch.points[i].fold_omega.unwrap() / per))
+        .collect();
+    assert_eq!(folds.len(), 2, "{folds:?}");
+    let (a, b) = (folds[0].0, folds[1].0);
+    for (i, p) in branch.points.iter().enumerate() {
+        let f = p.floquet.as_ref().unwrap();
+        if i >= a && i < b {
+            assert!(
+                p.stable() == Some(false) && f.real_unstable() >= 1,
+                "middle point {i} at {} rpm: {:?}",
+                p.omega / per,
+                &f.multipliers[..2]
+            );
+        }
+    }
+    let outer_unstable = branch
+        .points
+        .iter()
+        .enumerate()
+        .filter(|(i, p)| (*i < a || *i > b) && p.stable() == Some(false))
+        .count();
+    assert!(outer_unstable <= unstable_outer, "{outer_unstable}");
+    [folds[0], folds[1]]
+}
+
+/// The transmission error `u = w·q` of element 0 at the start of `state` (`(q, q̇)`).
+fn coordinate(scene: &Scene, q: &[f64]) -> f64 {
+    let w = scene.model.elements()[0].weights();
+    w.iter().map(|&(i, c)| c * q[i]).sum()
+}
+
+/// Integrates `periods` periods from the orbit of `p` (its multipliers' orbit start) kicked by
+/// `kick` of its dynamic range in the element coordinate, and returns how far the element
+/// coordinate at the end lies from the orbit's, relative to its peak-to-peak range.
+fn drift(scene: &Scene, p: &BranchPoint, kick: f64, periods: usize) -> f64 {
+    let model = &scene.model;
+    let n = model.n_dofs();
+    let x0 = &p.floquet.as_ref().unwrap().orbit_start;
+    let w = model.elements()[0].weights();
+    // The element coordinate's peak-to-peak range from the harmonics.
+    let h = p.harmonics.len() / n;
+    let range = 2.0
+        * (1..h)
+            .map(|k| {
+                w.iter()
+                    .map(|&(i, c)| p.harmonics[k * n + i] * c)
+                    .sum::<num_complex::Complex64>()
+                    .norm()
+            })
+            .sum::<f64>();
+    // Kick the pinion (the element's first DOF) by `kick · range` along the coordinate.
+    let (i, c) = w[0];
+    let mut q = x0[..n].to_vec();
+    q[i] += kick * range / c;
+    let td = TimeSimulation {
+        rtol: 1e-10,
+        steady_tolerance: 1e-300,
+        max_periods: periods,
+        stall_periods: usize::MAX,
+        samples: 64,
+        initial: Some((q, x0[n..].to_vec())),
+        ..TimeSimulation::default()
+    };
+    let r = td.run(model, p.omega).unwrap();
+    let end = &r.end_state;
+    (coordinate(scene, &end[..n]) - coordinate(scene, &x0[..n])).abs() / range
+}
+
+/// The point of `branch.points[range]` nearest `omega`.
+fn nearest(branch: &Branch, range: std::ops::Range<usize>, omega: f64) -> usize {
+    range
+        .min_by(|&a, &b| {
+            let d = |i: usize| (branch.points[i].omega - omega).abs();
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap()
+}
+
+/// Middle orbits are left, outer ones kept, near both folds: at 95 % of the way from the
+/// lower fold to the upper, and at 5 %.
+fn time_checks(scene: &Scene, branch: &Branch, folds: [(usize, f64); 2], periods: usize) {
+    let per = scene.omega_per_speed;
+    let (a, b) = (folds[0].0, folds[1].0);
+    let (high, low) = (folds[0].1.max(folds[1].1), folds[0].1.min(folds[1].1));
+    let n = branch.points.len();
+    for share in [0.95, 0.05] {
+        let omega = (low + share * (high - low)) * per;
+        let middle = nearest(branch, a..b, omega);
+        let lower = nearest(branch, 0..a, omega);
+        let upper = nearest(branch, b + 1..n, omega);
+        for (name, i, leaves) in [
+            ("lower", lower, false),
+            ("middle", middle, true),
+            ("upper", upper, false),
+        ] {
+            let p = &branch.points[i];
+            let d = drift(scene, p, 1e-6, periods);
+            eprintln!(
+                "{name} branch at {:.1} rpm: drift {d:.2e} after {periods} periods",
+                p.omega / per
+            );
+            // The kick is 1e-6: an unstable orbit grows it a thousandfold (near the lower
+            // fold the middle and upper orbits are 1e-2 apart), a stable one keeps it small.
+            if leaves {
+                assert!(d > 1e-3, "{name} at {} rpm: {d:e}", p.omega / per);
+            } else {
+                assert!(d < 1e-4, "{name} at {} rpm: {d:e}", p.omega / per);
+            }
+        }
+    }
+}
+
+#[test]
+fn single_stage_run_up_has_an_unstable_middle_branch_between_two_folds() {
+    let (scene, branch) = sweep(
+        "examples/scenes/single_stage_backlash_run_up.toml",
+        3000.0,
+        9000.0,
+    );
+    let folds = folds(&scene, &branch, 0);
+    // Where the sweep located them (regression values; the real multiplier crosses +1
+    // between the fold's neighbours, which `folds` checks).
+    assert!((folds[0].1 - 5675.8).abs() < 2.0, "{folds:?}");
+    assert!((folds[1].1 - 3230.9).abs() < 2.0, "{folds:?}");
+    assert_eq!(branch.spurious_turns(), 0);
+    // Every turn has its evidence: a parity change of the real multipliers above +1.
+    for i in [folds[0].0, folds[1].0] {
+        let e = branch.points[i].turn_evidence.unwrap();
+        assert_ne!(e.before.1.unwrap() % 2, e.after.1.unwrap() % 2, "{e:?}");
+    }
+    time_checks(&scene, &branch, folds, 60);
+}
+
+#[test]
+#[ignore = "release: a sweep of 76 points with 128 harmonics and crank-period shooting"]
+fn crank_fundamental_run_up_keeps_multipliers_on_the_reported_orbits() {
+    let (scene, branch) = sweep(
+        "tests/data/s_curve/car_drivetrain_stage2_frozen.toml",
+        3000.0,
+        9000.0,
+    );
+    // The upper branch has a Neimark–Sacker window (3891 to 4171 rpm, a torus that time
+    // integration from there confirms: it does not settle).
+    let folds = folds(&scene, &branch, 4);
+    assert!((folds[0].1 - 5674.9).abs() < 5.0, "{folds:?}");
+    assert!((folds[1].1 - 3311.1).abs() < 5.0, "{folds:?}");
+    // The middle orbits' multipliers are the HB orbit's own: shooting found other orbits.
+    let (a, b) = (folds[0].0, folds[1].0);
+    let own = branch.points[a..b]
+        .iter()
+        .filter(|p| p.floquet.as_ref().unwrap().other_orbit.is_some())
+        .count();
+    assert!(own >= (b - a) / 2, "{own} of {}", b - a);
+    for p in &branch.points[a + 2..b - 2] {
+        assert!(p.floquet.as_ref().unwrap().max_abs() > 1e3);
+    }
+    // A spurious turn says why.
+    for p in branch.points.iter().filter(|p| p.spurious_turn) {
+        assert!(p.turn_evidence.is_some());
+    }
+    time_checks(&scene, &branch, folds, 30);
+}
