@@ -63,8 +63,7 @@ pub(crate) fn point_json(
 }
 
 /// The summary lines of the orbits the multipliers belong to: where the shooting found another
-/// periodic orbit than the point's (the HB orbit's own multipliers instead, or the stability
-/// unknown), and how many points have the HB orbit's multipliers ([`Orbit::Harmonic`]) with
+/// periodic orbit than the point's (the HB orbit's own multipliers instead), and how many points have the HB orbit's multipliers ([`Orbit::Harmonic`]) with
 /// the largest difference to the exact orbit's measured on the way. Empty where every point
 /// has its exact orbit's.
 pub(crate) fn orbit_lines(branch: &Branch, unit: &str, speed: impl Fn(f64) -> f64) -> Vec<String> {
