@@ -25,6 +25,7 @@ use crate::model::Model;
 use crate::residual::HarmonicBalance;
 use crate::solution::Solution;
 use crate::solve::coarse::coarse_harmonics;
+use crate::solve::ringing::{reference, rings_beyond};
 use crate::solve::{robust_start, Method, Newton};
 use crate::{Formulation, HarmonicBasis};
 use std::time::Instant;
@@ -39,7 +40,8 @@ pub struct ErrorEstimate {
     /// The same for its harmonics `0..=H` alone.
     #[serde(default)]
     pub kept_harmonics: f64,
-    /// The H of the finer solution it was estimated against (2H).
+    /// The H of the finer solution it was estimated against: 2H, or 4H or 8H where modes a
+    /// law that jumps in time makes ring lie above 2H (`solve::ringing`).
     pub reference_harmonics: usize,
     /// `relative` counts only the harmonics up to `reference_harmonics`, short of where the
     /// solution is known to have content (the exact piecewise solution beyond its work
@@ -74,9 +76,19 @@ const DENSE_REFINE: usize = 600;
 /// The refinement of `solution` on the basis with twice its harmonics (Newton from it, to a
 /// residual of 1e-12), or an error if Newton does not converge there.
 fn refine(model: &Model, solution: &Solution, formulation: Formulation) -> Result<Solution> {
+    refine_by(model, solution, formulation, 2)
+}
+
+/// The same on the basis with `factor` times the harmonics of `solution`.
+pub(super) fn refine_by(
+    model: &Model,
+    solution: &Solution,
+    formulation: Formulation,
+    factor: usize,
+) -> Result<Solution> {
     let basis = solution.basis();
     let n = model.n_dofs();
-    let fine = scaled(basis, 2 * basis.harmonics().max(1))?;
+    let fine = scaled(basis, factor * basis.harmonics().max(1))?;
     let hb = HarmonicBalance::with_formulation(model, fine, formulation)?;
     let mut ws = hb.workspace();
     let start = crate::harmonic::embed(solution.harmonics(), n, 1, fine.harmonics());
@@ -120,11 +132,12 @@ fn refine(model: &Model, solution: &Solution, formulation: Formulation) -> Resul
     }
 }
 
-/// The solution with twice the harmonics and samples of `solution`, found from it: the
-/// reference [`estimate_error`] measures against (for comparing other quantities of the two,
+/// The solution with twice the harmonics and samples of `solution` (four or eight times
+/// where modes that a jump in time excites ring above 2H), found from it: the reference
+/// [`estimate_error`] measures against (for comparing other quantities of the two,
 /// such as [`crate::compare::quantity_errors`] of a chosen one).
 pub fn refined_solution(model: &Model, solution: &Solution) -> Result<Solution> {
-    refine(model, solution, Formulation::Auto)
+    reference(model, solution, Formulation::Auto)
 }
 
 /// The estimated error of the harmonics `0..=H` of `solution` (module documentation).
@@ -146,7 +159,7 @@ pub fn estimate_error(model: &Model, solution: &Solution) -> Result<ErrorEstimat
             reason: "a static analysis (H = 0) averages the time variation out: no error estimate against a dynamic solution".into(),
         });
     }
-    let fine = refine(model, solution, Formulation::Auto)?;
+    let fine = reference(model, solution, Formulation::Auto)?;
     Ok(compare(model, solution, &fine))
 }
 
@@ -179,58 +192,6 @@ fn compare(model: &Model, coarse: &Solution, fine: &Solution) -> ErrorEstimate {
         reference_harmonics: h2,
     }
 }
-
-/// Largest model whose highest natural frequency [`rings_beyond`] computes (a dense
-/// symmetric eigenvalue problem per estimate).
-const RINGING_CHECK_DOFS: usize = 64;
-
-/// `true` where a law of `model` jumps in time and modes of `(M, K0)` above the harmonics of
-/// `fine` carry more than [`RINGING_SHARE`] of a jumping element's compliance
-/// `wᵀ K0⁺ w = Σ_j (w·φ_j)²/ω_j²` (elastic modes, `φ_j` M-normalised): every jump rings at
-/// those modes, the content the estimate compares against lacks them, and the estimate is a
-/// lower bound (a drivetrain whose mesh modes sit at harmonic 2300 of a crank/37 fundamental:
-/// the transmission error at H = 1024 estimated 9e-2 off, truly 0.44). A stiff mode the
-/// jumping elements do not move does not count. Not checked above [`RINGING_CHECK_DOFS`]
-/// DOFs.
-fn rings_beyond(model: &Model, fine: &HarmonicBasis) -> bool {
-    let jumping: Vec<&crate::model::Element> = model
-        .elements()
-        .iter()
-        .filter(|e| !e.law().time_breakpoints().is_empty())
-        .collect();
-    if jumping.is_empty() || model.n_dofs() > RINGING_CHECK_DOFS {
-        return false;
-    }
-    let Some(modes) = crate::solve::coarse::normal_modes(model) else {
-        return false;
-    };
-    let resolved = fine.harmonics() as f64 * fine.fundamental();
-    let top = modes.frequencies.iter().fold(0.0_f64, |m, w| m.max(*w));
-    jumping.iter().any(|e| {
-        let (mut beyond, mut all) = (0.0, 0.0);
-        for (j, &w) in modes.frequencies.iter().enumerate() {
-            if w <= 1e-6 * top {
-                continue; // a rigid-body mode
-            }
-            let share = e
-                .weights()
-                .iter()
-                .map(|&(i, wi)| wi * modes.shapes[(i, j)])
-                .sum::<f64>()
-                .powi(2)
-                / (w * w);
-            all += share;
-            if w > resolved {
-                beyond += share;
-            }
-        }
-        all > 0.0 && beyond > RINGING_SHARE * all
-    })
-}
-
-/// The share of a jumping element's compliance in modes above the resolved harmonics from
-/// which the error estimate is a lower bound.
-const RINGING_SHARE: f64 = 1e-4;
 
 /// The smallest estimate reported: rounding.
 pub const FLOOR: f64 = 1e-15;
@@ -407,7 +368,7 @@ pub fn solve_auto(
                 ),
             });
         }
-        let fine = refine(model, &current, auto.formulation)?;
+        let fine = reference(model, &current, auto.formulation)?;
         let estimate = compare(model, &current, &fine);
         levels.push(Level {
             harmonics: level_basis.harmonics(),
@@ -418,7 +379,8 @@ pub fn solve_auto(
         // A lower bound is no reason to stop, unless only the harmonics 0..H count.
         let bound_only = estimate.lower_bound && auto.control != Control::Harmonics;
         let reached = auto.control.of(&estimate) <= auto.tolerance && !bound_only;
-        let capped = !reached && fine.basis().harmonics() > auto.max_harmonics;
+        // The next level has 2H (the reference may have more, where modes ring above 2H).
+        let capped = !reached && 2 * level_basis.harmonics() > auto.max_harmonics;
         if capped {
             if let Some(exact) = exact_instead(model, basis, auto, &levels) {
                 return Ok(exact);
@@ -434,8 +396,12 @@ pub fn solve_auto(
                 switched_to_exact: false,
             });
         }
-        level_basis = *fine.basis();
-        current = fine;
+        current = if fine.basis().harmonics() <= auto.max_harmonics {
+            fine
+        } else {
+            refine(model, &current, auto.formulation)?
+        };
+        level_basis = *current.basis();
     }
 }
 

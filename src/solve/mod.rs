@@ -16,6 +16,7 @@ mod method;
 mod newton;
 pub mod piecewise;
 mod problem;
+mod ringing;
 mod run;
 mod start;
 

@@ -3,9 +3,9 @@
 //! rectangular mesh stiffness, final drive) at 2000 rpm, fundamental crank/37, mesh 1 at
 //! harmonic 851. Harmonic balance at H = 1024 gets stage 1's transmission error 55 % low
 //! (9.7 µm peak to peak against 21.4 µm) against the exact piecewise solution while its
-//! whole-solution estimate says 3e-5: the per-quantity estimate sees it (worst quantity
-//! stage 2's transmission error, 0.29 of its range), declares itself a lower bound (the mesh
-//! modes ring beyond 2H), and automatic harmonics on the quantities hand over to the exact
+//! whole-solution estimate says 1.5e-4: the per-quantity estimate sees it (worst quantity
+//! stage 1's force, 0.50 of its range; the reference goes to 4H, where the mesh modes ring),
+//! and automatic harmonics on the quantities hand over to the exact
 //! solution. Release only (the exact solution takes about a minute): `.ci/run` runs it.
 
 use hbal::compare::{quantity_errors, Quantity};
@@ -41,11 +41,13 @@ fn transmission_error_is_estimated_per_quantity() {
         worst.quantity.name(model),
         worst.error
     );
-    assert!(e.relative < 1e-4, "{e:?}");
+    assert!(e.relative < 1e-3, "{e:?}");
     assert!(worst.error > 0.1, "{worst:?}");
-    // The mesh modes ring near harmonic 2300, beyond the H = 2048 the estimate looks at: it
-    // is declared a lower bound.
-    assert!(e.lower_bound, "{e:?}");
+    // The mesh modes ring near harmonic 2300, beyond 2H = 2048: the estimate's reference
+    // goes on to 4H, which holds them (against 2H it was a lower bound, 9.1e-2 for a true
+    // 0.44).
+    assert_eq!(e.reference_harmonics, 4096);
+    assert!(!e.lower_bound, "{e:?}");
 
     // Automatic harmonics on the quantities: harmonic balance stops at the cap, the exact
     // piecewise solution answers.
@@ -112,8 +114,7 @@ fn transmission_error_is_estimated_per_quantity() {
         estimate.error
     );
     assert!(hb_pp < 0.6 * exact_pp);
-    // A lower bound (measured 9.1e-2 against the true 0.44: the factor 3 the issue asks for is
-    // not met while the ringing lies above 2H), but not an empty one.
+    // Within a factor 3 of the true error.
     let ratio = estimate.error / true_error;
-    assert!((0.1..=3.0).contains(&ratio), "{ratio}");
+    assert!((1.0 / 3.0..=3.0).contains(&ratio), "{ratio}");
 }

@@ -91,10 +91,11 @@ pub enum Breach {
 }
 
 /// Keys whose value may be `null` by the documented schema (docs/scenes.md).
-const NULLABLE: [&str; 6] = [
+const NULLABLE: [&str; 7] = [
     "auto_harmonics",
     "error_estimate",
     "gear_stage",
+    "other_orbit",
     "reduction",
     "stability",
     "start",
