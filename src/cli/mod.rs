@@ -104,8 +104,8 @@ pub(crate) struct SolverArgs {
     /// scene's `harmonics.tolerance` (default 1e-6) (default: the scene's). `auto:harmonics`
     /// controls the error of the harmonics 0..H alone (order amplitudes), `auto:quantities`
     /// that of every DOF and element coordinate on its own (dynamic part against its own
-    /// range, peak values included), `auto:solution` that of the periodic solution with the
-    /// harmonics it lacks (the default).
+    /// range, peak values included; the default), `auto:solution` that of the periodic
+    /// solution as a whole with the harmonics it lacks.
     #[arg(long)]
     pub(crate) harmonics: Option<HarmonicsArg>,
     /// Number of time samples N per period, at least 2H+1 (default: the scene's, or the

@@ -342,10 +342,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 if f.multipliers.len() == 1 { "" } else { "s" },
                 f.neutral,
                 f.orbit_correction,
-                if f.polished {
-                    ""
-                } else {
-                    " (shooting did not converge: multipliers along the HB orbit)"
+                match (f.polished, f.orbit_distance > hbal::stability::OTHER_ORBIT_DISTANCE) {
+                    (false, _) => " (shooting did not converge: multipliers along the HB orbit)".to_string(),
+                    (true, true) => format!(
+                        " (the exact orbit starts {:.1e} of the dynamic range from the HB orbit: the HB solution is that far off)",
+                        f.orbit_distance
+                    ),
+                    (true, false) => String::new(),
                 },
                 stability_seconds * 1e3
             ),

@@ -92,6 +92,20 @@ pub(crate) fn orbit_lines(branch: &Branch, unit: &str, speed: impl Fn(f64) -> f6
             super::speed_text(hi),
         ));
     }
+    let far: Vec<f64> = floquets()
+        .filter(|(_, f)| {
+            f.other_orbit.is_none() && f.orbit_distance > hbal::stability::OTHER_ORBIT_DISTANCE
+        })
+        .map(|(_, f)| f.orbit_distance)
+        .collect();
+    if !far.is_empty() {
+        lines.push(format!(
+            "the exact orbit starts up to {:.1e} of the dynamic range from the HB orbit at {} point{} (the HB solution is that far off there; the multipliers are the exact orbit's)",
+            far.iter().copied().fold(0.0, f64::max),
+            far.len(),
+            if far.len() == 1 { "" } else { "s" }
+        ));
+    }
     let harmonic: Vec<f64> = floquets()
         .filter(|(_, f)| f.orbit == Orbit::Harmonic && f.other_orbit.is_none())
         .map(|(_, f)| f.orbit_difference.unwrap_or(f64::NAN))

@@ -201,12 +201,14 @@ pub const FLOOR: f64 = 1e-15;
 #[serde(rename_all = "snake_case")]
 pub enum Control {
     /// The periodic solution's, including the harmonics above H it lacks
-    /// ([`ErrorEstimate::relative`]): the time signal, its extremes and max |q|. The default.
-    #[default]
+    /// ([`ErrorEstimate::relative`]): the time signal, its extremes and max |q|, relative to
+    /// the whole solution (where the static wind-up of the shafts may dominate).
     Solution,
     /// Every DOF and element coordinate on its own, by its dynamic part relative to its own
     /// range ([`ErrorEstimate::worst_quantity`]): the transmission error of a gear stage is
     /// controlled even where the static wind-up of the shafts dominates the whole solution.
+    /// The default: what the engineer reads.
+    #[default]
     Quantities,
     /// Its harmonics `0..=H` alone ([`ErrorEstimate::kept_harmonics`]): order amplitudes and
     /// phases, the order cuts of a run-up. A jumping mesh stiffness leaves the harmonics above
