@@ -345,7 +345,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 match (f.polished, f.orbit_distance > hbal::stability::OTHER_ORBIT_DISTANCE) {
                     (false, _) => " (shooting did not converge: multipliers along the HB orbit)".to_string(),
                     (true, true) => format!(
-                        " (the exact orbit starts {:.1e} of the dynamic range from the HB orbit: the HB solution is that far off)",
+                        " (the exact orbit starts {:.1e} of the dynamic range from the HB orbit: the HB solution is that far off, or the shooting found a neighbouring orbit of the same kind)",
                         f.orbit_distance
                     ),
                     (true, false) => String::new(),

@@ -87,7 +87,7 @@ fn run_auto(
     let mut branch = segments.remove(0);
     let mut steps = vec![format!("H = {}", branch.harmonics)];
     for s in segments {
-        if let hbal::continuation::BranchStop::HarmonicsRaised { omega, harmonics } = branch.stop {
+        if let hbal::continuation::BranchStop::HarmonicsChanged { omega, harmonics } = branch.stop {
             steps.push(format!("H = {harmonics} from {omega:.6} rad/s"));
         }
         branch.points.extend(s.points);
@@ -386,7 +386,10 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 if matches!(scene.method, hbal::solve::Method::PiecewiseExact(_)) {
                     "what the exact solution lacks above H, and rounding".to_string()
                 } else {
-                    format!("against 2H = {}", 2 * branch.harmonics)
+                    format!(
+                        "against 2H = {}, more where a jumping stiffness rings above it",
+                        2 * branch.harmonics
+                    )
                 }
             );
         }

@@ -100,7 +100,7 @@ pub(crate) fn orbit_lines(branch: &Branch, unit: &str, speed: impl Fn(f64) -> f6
         .collect();
     if !far.is_empty() {
         lines.push(format!(
-            "the exact orbit starts up to {:.1e} of the dynamic range from the HB orbit at {} point{} (the HB solution is that far off there; the multipliers are the exact orbit's)",
+            "the exact orbit starts up to {:.1e} of the dynamic range from the HB orbit at {} point{} (the HB solution is that far off there, or the shooting found a neighbouring orbit of the same kind; the multipliers are the exact orbit's)",
             far.iter().copied().fold(0.0, f64::max),
             far.len(),
             if far.len() == 1 { "" } else { "s" }

@@ -1,5 +1,6 @@
 //! Locating a bifurcation on a branch: regula falsi (Illinois) on a test function of the
-//! exact orbits' Floquet multipliers, between the two points whose stability changed, each
+//! Floquet multipliers (the exact orbits', or the HB orbits' own where the shooting found another
+//! orbit, see `stability::orbit_distance`), between the two points whose stability changed, each
 //! trial point corrected onto the branch (branch switching starts from it, see `switch`).
 
 use super::bordered::{Scales, Target, Tracer};

@@ -53,7 +53,7 @@ pub struct BranchPoint {
     #[serde(default)]
     pub truncation: f64,
     /// The estimated relative error of the point's periodic solution, against the solution
-    /// with 2H harmonics ([`estimate_error`](crate::solve::estimate_error)), if asked for
+    /// with 2H harmonics, or more ([`estimate_error`](crate::solve::estimate_error)), if asked for
     /// ([`Continuation::error_estimate`]).
     #[serde(default)]
     pub error_estimate: Option<f64>,
@@ -163,9 +163,9 @@ pub enum BranchStop {
         reason: String,
     },
     /// Automatic harmonics ([`Continuation::run_auto`]): the point at this Ω exceeded the
-    /// tolerance, and the branch goes on from it with `harmonics` harmonics in the next
-    /// segment (a normal end of this one).
-    HarmonicsRaised {
+    /// tolerance (or lay far below it), and the branch goes on from it with `harmonics`
+    /// harmonics in the next segment (a normal end of this one).
+    HarmonicsChanged {
         /// Where.
         omega: f64,
         /// The next segment's H.
@@ -185,7 +185,7 @@ impl std::fmt::Display for BranchStop {
                 write!(f, "singular bordered system near Ω = {omega}")
             }
             BranchStop::SwitchFailed { reason } => write!(f, "no branch switch: {reason}"),
-            BranchStop::HarmonicsRaised { omega, harmonics } => {
+            BranchStop::HarmonicsChanged { omega, harmonics } => {
                 write!(
                     f,
                     "goes on with H = {harmonics} from Ω = {omega} (automatic harmonics)"
@@ -270,7 +270,7 @@ impl BranchStop {
     pub fn is_normal_end(&self) -> bool {
         matches!(
             self,
-            BranchStop::Reached | BranchStop::Rejoined { .. } | BranchStop::HarmonicsRaised { .. }
+            BranchStop::Reached | BranchStop::Rejoined { .. } | BranchStop::HarmonicsChanged { .. }
         )
     }
 }

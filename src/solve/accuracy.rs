@@ -10,13 +10,14 @@
 //! true error, where
 //! a measure of the top harmonics' size (the former truncation estimate) was up to 600 times
 //! too pessimistic (a backlash contact with kink-aware quadrature) or 30 times too optimistic
-//! (a stiffness jump sampled off its position).
+//! (a stiffness jump sampled off its position). Where a law jumps in time and modes it
+//! excites lie above 2H, the reference goes on to 4H or 8H ([`ringing`](super::ringing)).
 //!
 //! **Automatic H.** [`solve_auto`] solves at `H = H0, 2 H0, 4 H0, ...` (each level
-//! warm-started from the last, and each level's refinement is the next level), and returns
+//! warm-started from the last, and each level's 2H refinement is the next level), and returns
 //! the first solution whose estimate is below the tolerance, or, at the cap, the last one with
-//! a message. The estimate is the whole solution's by default, or that of its harmonics
-//! `0..=H` alone ([`Control`]).
+//! a message. The estimate is that of every DOF and element coordinate by default, or the
+//! whole solution's, or that of its harmonics `0..=H` alone ([`Control`]).
 
 use crate::compare::quantities::{quantity_errors, worst};
 use crate::compare::{relative_error, QuantityError};
@@ -75,7 +76,11 @@ const DENSE_REFINE: usize = 600;
 
 /// The refinement of `solution` on the basis with twice its harmonics (Newton from it, to a
 /// residual of 1e-12), or an error if Newton does not converge there.
-fn refine(model: &Model, solution: &Solution, formulation: Formulation) -> Result<Solution> {
+pub(crate) fn refine(
+    model: &Model,
+    solution: &Solution,
+    formulation: Formulation,
+) -> Result<Solution> {
     refine_by(model, solution, formulation, 2)
 }
 

@@ -20,6 +20,7 @@ mod ringing;
 mod run;
 mod start;
 
+pub(crate) use accuracy::refine;
 pub use accuracy::{
     estimate_error, refined_solution, solve_auto, AutoHarmonics, AutoSolution, Control,
     ErrorEstimate, Level,

@@ -223,14 +223,9 @@ impl FloquetOptions {
         let Shot {
             mut floquet, kappa, ..
         } = shot;
-        let other = floquet.orbit_distance > OTHER_ORBIT_DISTANCE;
-        if other {
-            // Another orbit: its monodromy matrix and correction would lead the next points'
-            // shootings to it as well.
+        // Possibly another orbit: the caller decides ([`FloquetOptions::own_multipliers`]).
+        if floquet.orbit_distance > OTHER_ORBIT_DISTANCE {
             floquet.other_orbit = Some(floquet.orbit_distance);
-            cache.jacobian = None;
-            cache.corrections.clear();
-            return Ok(floquet);
         }
         cache.kappa = kappa.or(cache.kappa);
         cache.jacobian = Some(shot.jacobian);
@@ -294,7 +289,8 @@ impl FloquetOptions {
         let Some(info) = floquet.reduction.as_mut() else {
             return Ok(());
         };
-        if info.estimate.is_some() {
+        // (shooting on the wider basis would glide onto the other orbit again)
+        if info.estimate.is_some() || floquet.other_orbit.is_some() {
             return Ok(());
         }
         let mut wider = 2.0 * info.cutoff;

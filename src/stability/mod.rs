@@ -202,11 +202,12 @@ impl Floquet {
         self.max_abs() <= 1.0 + STABILITY_MARGIN
     }
 
-    /// Number of real multipliers greater than 1 (a fold or branch point changes it by one).
+    /// Number of real multipliers greater than `1 +` [`STABILITY_MARGIN`] (a fold or branch
+    /// point changes it by one); real as in [`Floquet::critical`].
     pub fn real_unstable(&self) -> usize {
         self.multipliers
             .iter()
-            .filter(|m| m.im.abs() <= 1e-9 * m.norm().max(1.0) && m.re > 1.0)
+            .filter(|m| is_real(m) && m.re > 1.0 + STABILITY_MARGIN)
             .count()
     }
 
@@ -218,7 +219,7 @@ impl Floquet {
     pub fn critical(&self) -> Option<Bifurcation> {
         let m = *self.multipliers.first()?;
         let angle = m.arg().abs();
-        let real = m.im.abs() <= 1e-6 * m.norm();
+        let real = is_real(&m);
         Some(if real && angle < 0.1 {
             Bifurcation::Fold
         } else if real && angle > std::f64::consts::PI - 0.1 {
@@ -227,6 +228,12 @@ impl Floquet {
             Bifurcation::NeimarkSacker
         })
     }
+}
+
+/// A multiplier within 1e-6 of its modulus of the real axis (a double real root splits into
+/// a pair that close by rounding).
+fn is_real(m: &Complex64) -> bool {
+    m.im.abs() <= 1e-6 * m.norm()
 }
 
 /// Options of the Floquet analysis.

@@ -15,7 +15,7 @@
 //! exact orbit's on the wider basis (both errors together).
 
 use super::dispatch::FloquetCache;
-use super::orbit_identity::same_kind;
+use super::orbit_identity::{forget_orbit, same_kind};
 use super::shooting::{distance, shoot, Goal, Start};
 use super::system::Coordinates;
 use super::{Floquet, FloquetOptions, Integrator, Orbit, ORBIT_CHECK_EVERY, STABILITY_MARGIN};
@@ -88,6 +88,7 @@ impl FloquetOptions {
             // The shooting found another orbit: nothing to measure against, and the HB
             // orbit's multipliers are the answer (measured again at the next point).
             cache.orbit_check = None;
+            forget_orbit(cache);
             floquet.other_orbit = exact.other_orbit;
             floquet.steps += exact.steps;
             return Ok(floquet);

@@ -40,6 +40,9 @@ pub const OTHER_ORBIT_DISTANCE: f64 = 5e-3;
 /// Velocities are left out: the HB velocity converges slowest where a stiffness jumps.
 pub fn orbit_distance(model: &Model, solution: &Solution, hb: &[f64], x: &[f64]) -> f64 {
     let n = model.n_dofs();
+    if !x.iter().chain(hb).all(|v| v.is_finite()) {
+        return f64::INFINITY;
+    }
     let h = solution.basis().harmonics();
     let dynamic = |i: usize| (1..=h).map(|k| solution.harmonic(i, k).norm()).sum::<f64>();
     let largest = (0..n).map(dynamic).fold(0.0, f64::max);
@@ -98,20 +101,21 @@ impl FloquetOptions {
         mut found: Floquet,
     ) -> Result<Floquet> {
         let own = match self.integrator {
-            Integrator::Auto => Some(self.hb_orbit(sys, solution, cache)?),
-            Integrator::RungeKutta => None,
+            Integrator::Auto if !cache.exact_only => Some(self.hb_orbit(sys, solution, cache)?),
+            _ => None,
         };
-        match own.filter(|o| o.orbit == Orbit::Harmonic) {
+        match own {
+            Some(o) if o.orbit != Orbit::Harmonic => cache.exact_only = true,
             Some(mut own) if !same_kind(&own, &found) => {
                 own.other_orbit = found.other_orbit;
                 own.steps += found.steps;
-                Ok(own)
+                forget_orbit(cache);
+                return Ok(own);
             }
-            _ => {
-                found.other_orbit = None;
-                Ok(found)
-            }
+            _ => {}
         }
+        found.other_orbit = None;
+        Ok(found)
     }
 
     /// The multipliers of the HB orbit's own pieces (the exact orbit's where they do not
@@ -137,6 +141,13 @@ impl FloquetOptions {
         )?;
         Ok(shot.floquet)
     }
+}
+
+/// Another orbit's monodromy matrix and corrections would lead the next points' shootings to
+/// it as well: dropped.
+pub(super) fn forget_orbit(cache: &mut FloquetCache) {
+    cache.jacobian = None;
+    cache.corrections.clear();
 }
 
 /// The same stability and the same number of real multipliers above +1.
