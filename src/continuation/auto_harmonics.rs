@@ -3,7 +3,7 @@
 //! tolerance or at the cap) and the branch goes on from it on the new basis, as a new segment.
 //! Where a point lies far below the tolerance ([`LOWER_BELOW`], at least [`LOWER_AFTER`]
 //! points into its segment), H/2 is tried there: if its own estimate is within a quarter of
-//! the tolerance, the branch goes on with H/2 (never below the first segment's H).
+//! the tolerance, the branch goes on with H/2.
 
 use super::{Branch, BranchStop, Continuation};
 use crate::error::Result;
@@ -20,8 +20,7 @@ impl Continuation {
     /// the branch goes on at the cap's H). Where a point lies far below the tolerance, H is
     /// halved there if the halved solution still meets a quarter of it (module
     /// documentation). `basis` is the first segment's (from
-    /// [`solve_auto`](crate::solve::solve_auto) at the first speed), `initial` its solution;
-    /// H never goes below the first segment's.
+    /// [`solve_auto`](crate::solve::solve_auto) at the first speed), `initial` its solution.
     pub fn run_auto(
         &self,
         model: &Model,
@@ -38,7 +37,6 @@ impl Continuation {
         let mut segments = Vec::new();
         let (mut basis, mut start) = (basis, initial.map(|q| q.to_vec()));
         let direction = (to - basis.omega()).signum();
-        let lowest = basis.harmonics();
         loop {
             let mut branch = tracer.run_from(model, basis, to, start.as_deref(), &mut progress)?;
             let capped = 2 * basis.harmonics() > auto.max_harmonics;
@@ -58,7 +56,7 @@ impl Continuation {
                 .find(|&i| forward(i) && error(i).is_some_and(|e| e > auto.tolerance));
             let under = (LOWER_AFTER..branch.points.len())
                 .find(|&i| forward(i) && error(i).is_some_and(|e| e < LOWER_BELOW * auto.tolerance))
-                .filter(|&j| basis.harmonics() / 2 >= lowest && over.is_none_or(|i| j < i));
+                .filter(|&j| basis.harmonics() >= 2 && over.is_none_or(|i| j < i));
             if let Some(j) = under {
                 let omega = branch.points[j].omega;
                 let at = basis.with_omega(omega)?;

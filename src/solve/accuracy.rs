@@ -261,7 +261,7 @@ pub struct AutoHarmonics {
     pub max_harmonics: usize,
     /// The formulation of every level. Default [`Formulation::Auto`].
     pub formulation: Formulation,
-    /// Which error the tolerance applies to. Default [`Control::Solution`].
+    /// Which error the tolerance applies to. Default [`Control::Quantities`].
     pub control: Control,
 }
 

@@ -359,3 +359,68 @@ fn automatic_harmonics_hold_along_a_branch() {
     }
     assert!(worst < 1e-6, "{worst:e}");
 }
+
+/// Automatic harmonics lowered along a branch: the backlash pair (forcing 0.1) from 0.44 rad/s,
+/// where the contact opens and H = 64 is needed (reached from 1.6 rad/s), back up to 1.6 rad/s, where it stays closed and
+/// far fewer suffice: H comes down (64, 32, 16) where the points lie far below the tolerance,
+/// and every checked point stays within it against H = 256.
+#[test]
+fn automatic_harmonics_come_down_along_a_branch() {
+    use hbal::catalog::GearBacklash;
+    use hbal::solve::{solve_auto, AutoHarmonics, Method};
+    let model = GearBacklash {
+        fa: 0.1,
+        ..GearBacklash::default()
+    }
+    .model()
+    .unwrap();
+    let auto = AutoHarmonics::default();
+    let method = Method::Newton(Newton::new());
+    // Down to 0.44 rad/s first (Newton from the linear start fails there, issue 31), then back.
+    let first = solve_auto(&model, HarmonicBasis::new(1.6, 8).unwrap(), &method, auto).unwrap();
+    let cont = Continuation {
+        stability: None,
+        ..Continuation::default()
+    };
+    let down = cont
+        .run_auto(
+            &model,
+            *first.solution.basis(),
+            0.44,
+            Some(first.solution.harmonics()),
+            auto,
+            |_| {},
+        )
+        .unwrap();
+    let last = down.last().unwrap();
+    let p = last.points.last().unwrap();
+    let start_h = last.harmonics;
+    let basis = HarmonicBasis::new(p.omega, start_h)
+        .unwrap()
+        .with_tail_correction(true);
+    let segments = cont
+        .run_auto(&model, basis, 1.6, Some(&p.harmonics), auto, |_| {})
+        .unwrap();
+    let hs: Vec<usize> = segments.iter().map(|b| b.harmonics).collect();
+    eprintln!("first H {start_h}, segments {hs:?}");
+    assert_eq!(segments.last().unwrap().stop, BranchStop::Reached);
+    assert!(*hs.last().unwrap() < start_h, "{hs:?}");
+    let mut worst: f64 = 0.0;
+    for b in &segments {
+        for p in b.points.iter().step_by(5) {
+            let fine =
+                HarmonicBalance::new(&model, HarmonicBasis::new(p.omega, 256).unwrap()).unwrap();
+            let start = hbal::harmonic::embed(&p.harmonics, 1, 1, 256);
+            let reference = Newton::new()
+                .with_tolerance(1e-12)
+                .unwrap()
+                .solve_from(&fine, &start, &mut fine.workspace())
+                .unwrap();
+            assert!(reference.is_converged());
+            let e = relative_error(&p.harmonics, reference.harmonics(), 1, 256);
+            worst = worst.max(e);
+        }
+    }
+    eprintln!("worst against H = 256: {worst:.2e}");
+    assert!(worst < 1e-6, "{worst:e}");
+}
