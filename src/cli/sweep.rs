@@ -319,9 +319,11 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             .count();
         let spurious = branch.spurious_turns();
         say!(
-            "{}: {} points from {from} to {to} {unit} in {:.1} ms: {}; {} fold{}, {} unstable point{}{}",
+            "{}: {} points from {} to {} {unit} in {:.1} ms: {}; {} fold{}, {} unstable point{}{}",
             scene.file,
             branch.points.len(),
+            super::speed_text(from),
+            super::speed_text(to),
             seconds * 1e3,
             branch.stop,
             branch.folds(),
