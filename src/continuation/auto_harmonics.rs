@@ -38,7 +38,7 @@ impl Continuation {
         let (mut basis, mut start) = (basis, initial.map(|q| q.to_vec()));
         let direction = (to - basis.omega()).signum();
         loop {
-            let mut branch = tracer.run_from(model, basis, to, start.as_deref(), &mut progress)?;
+            let branch = tracer.run_from(model, basis, to, start.as_deref(), &mut progress)?;
             let capped = 2 * basis.harmonics() > auto.max_harmonics;
             let error = |i: usize| {
                 let p = &branch.points[i];
@@ -67,14 +67,7 @@ impl Continuation {
                     self.formulation,
                     auto,
                 ) {
-                    branch.points.truncate(j);
-                    branch.stop = BranchStop::HarmonicsChanged {
-                        omega,
-                        harmonics: lowered.basis().harmonics(),
-                    };
-                    segments.push(branch);
-                    basis = *lowered.basis();
-                    start = Some(lowered.harmonics().to_vec());
+                    (basis, start) = end_segment(&mut segments, branch, j, &lowered);
                     continue;
                 }
             }
@@ -90,16 +83,26 @@ impl Continuation {
                 self.formulation,
                 auto,
             )?;
-            branch.points.truncate(i);
-            branch.stop = BranchStop::HarmonicsChanged {
-                omega,
-                harmonics: raised.basis().harmonics(),
-            };
-            segments.push(branch);
-            basis = *raised.basis();
-            start = Some(raised.harmonics().to_vec());
+            (basis, start) = end_segment(&mut segments, branch, i, &raised);
         }
     }
+}
+
+/// Ends `branch` before its point `i`, where the next segment goes on with `next` (its basis
+/// and harmonics returned).
+fn end_segment(
+    segments: &mut Vec<Branch>,
+    mut branch: Branch,
+    i: usize,
+    next: &crate::Solution,
+) -> (HarmonicBasis, Option<Vec<num_complex::Complex64>>) {
+    branch.stop = BranchStop::HarmonicsChanged {
+        omega: branch.points[i].omega,
+        harmonics: next.basis().harmonics(),
+    };
+    branch.points.truncate(i);
+    segments.push(branch);
+    (*next.basis(), Some(next.harmonics().to_vec()))
 }
 
 /// The point with harmonics `q` on `basis` refined until its estimate meets the tolerance or
