@@ -24,11 +24,17 @@ pub(crate) fn estimate_fields(model: &Model, e: &ErrorEstimate) -> Value {
     json!({
         "worst_quantity": quantity_json(model, e.worst_quantity),
         "worst_force": quantity_json(model, e.worst_force),
+        "quadrature": e.quadrature.map(|q| json!({
+            "relative": q.relative,
+            "samples": q.samples,
+            "reference_samples": q.reference_samples,
+        })),
     })
 }
 
 /// `"; worst quantity u(mesh) 1.8e-2 of its range 4.1e-5, force f(mesh) 2.2e-2"`, or
-/// nothing where the quantities were not estimated.
+/// nothing where the quantities were not estimated; with `"; contact quadrature 3.1e-8 of
+/// the load (...)"` where a law's crossings take the corrected trapezoid rule.
 pub(crate) fn summary(model: &Model, e: &ErrorEstimate) -> String {
     let mut out = String::new();
     if let Some(q) = e.worst_quantity {
@@ -41,6 +47,12 @@ pub(crate) fn summary(model: &Model, e: &ErrorEstimate) -> String {
     }
     if let Some(f) = e.worst_force {
         out += &format!(", force {} {:.1e}", f.quantity.name(model), f.error);
+    }
+    if let Some(q) = e.quadrature {
+        out += &format!(
+            "; contact quadrature {:.1e} of the load (corrected trapezoid rule on {} samples, against {}: a law with kinks that is not affine between them)",
+            q.relative, q.samples, q.reference_samples
+        );
     }
     out
 }

@@ -35,6 +35,7 @@ pub(crate) fn point_json(
         "error_estimate": p.error_estimate,
         "error_estimate_harmonics": p.error_estimate_harmonics,
         "worst_quantity": p.worst_quantity,
+        "quadrature": p.quadrature,
         "max_abs": p.max_abs,
         "multipliers": f.map(multipliers_json),
         "multipliers_abs": f.map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),

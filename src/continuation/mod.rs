@@ -65,6 +65,10 @@ pub struct BranchPoint {
     /// ([`ErrorEstimate::worst_quantity`](crate::solve::ErrorEstimate::worst_quantity)).
     #[serde(default)]
     pub worst_quantity: Option<crate::compare::QuantityError>,
+    /// The AFT's quadrature error relative to the load where a law's contact crossings take
+    /// the corrected trapezoid rule ([`ErrorEstimate::quadrature`](crate::solve::ErrorEstimate::quadrature)).
+    #[serde(default)]
+    pub quadrature: Option<f64>,
     /// Floquet multipliers, if computed.
     pub floquet: Option<Floquet>,
     /// A turning point of the branch lies between the previous point and this one, confirmed

@@ -178,6 +178,7 @@ impl Continuation {
         let error_estimate = estimate.and_then(|e| finite(e.relative));
         let error_estimate_harmonics = estimate.and_then(|e| finite(e.kept_harmonics));
         let worst_quantity = estimate.and_then(|e| e.worst_quantity);
+        let quadrature = estimate.and_then(|e| e.quadrature).map(|q| q.relative);
         let residual = sol.residual();
         branch.points.push(BranchPoint {
             parameter: p.parameter,
@@ -189,6 +190,7 @@ impl Continuation {
             error_estimate,
             error_estimate_harmonics,
             worst_quantity,
+            quadrature,
             floquet,
             // Set by the caller for a turn, then [`classify_turns`] decides once the
             // neighbours are known.

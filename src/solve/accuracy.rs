@@ -60,6 +60,12 @@ pub struct ErrorEstimate {
     /// closes is only as good as the crossing's position).
     #[serde(default)]
     pub worst_force: Option<QuantityError>,
+    /// The AFT's quadrature error at the solution where a law's contact crossings take the
+    /// corrected trapezoid rule instead of exact integration (a cosine or Fourier mesh
+    /// stiffness under backlash, a user's law; [`crate::solve::quadrature_error`]); `None`
+    /// where every crossing is integrated exactly or none is crossed.
+    #[serde(default)]
+    pub quadrature: Option<crate::solve::QuadratureError>,
 }
 
 /// The basis with `harmonics` harmonics at the Ω and ν of `basis`, with as many samples per
@@ -195,6 +201,7 @@ fn compare(model: &Model, coarse: &Solution, fine: &Solution) -> ErrorEstimate {
         relative: relative_error(coarse.harmonics(), fine.harmonics(), n, h2).max(FLOOR),
         kept_harmonics: relative_error(coarse.harmonics(), fine.harmonics(), n, h).max(FLOOR),
         reference_harmonics: h2,
+        quadrature: crate::solve::quadrature_error(model, coarse).ok().flatten(),
     }
 }
 

@@ -16,6 +16,7 @@ mod method;
 mod newton;
 pub mod piecewise;
 mod problem;
+mod quadrature;
 mod ringing;
 mod run;
 mod start;
@@ -32,6 +33,7 @@ pub use method::Method;
 pub use newton::{Newton, NewtonSolver};
 pub use piecewise::{ExactSolution, PiecewiseExact};
 pub use problem::HbProblem;
+pub use quadrature::{quadrature_error, QuadratureError, QUADRATURE_OVERSAMPLING};
 pub use run::{HbSolver, HbState, Progress, MAX_DENSE_UNKNOWNS};
 pub use start::{robust_start, StartReport};
 

@@ -268,6 +268,7 @@ impl PiecewiseExact {
             lower_bound,
             worst_quantity: None,
             worst_force: None,
+            quadrature: None,
         };
         // The exact solution has harmonics above H: an element's force from the kept ones
         // balances the equation of motion only with the tail correction's part (see

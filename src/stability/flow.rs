@@ -24,6 +24,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::dopri::{step_factor, Stepper};
+use super::guide::Guide;
 use super::pieces::Pieces;
 use super::system::Coordinates;
 use crate::error::{Error, Result};
@@ -62,6 +63,8 @@ pub(crate) struct Flow<'c, 'm> {
     h_last: f64,
     /// Steps taken (accepted and rejected).
     pub steps: usize,
+    /// The HB orbit the state follows instead of the equations of motion ([`Guide`]).
+    guide: Option<Guide>,
 }
 
 impl<'c, 'm> Flow<'c, 'm> {
@@ -119,7 +122,15 @@ impl<'c, 'm> Flow<'c, 'm> {
             h_last: 0.0,
             phasor_base: (0.0, 1.0, 0.0),
             steps: 0,
+            guide: None,
         })
+    }
+
+    /// The flow along the HB orbit `guide` (the variational equation about it; the state
+    /// `(q, q̇)` must start on it).
+    pub(crate) fn along(mut self, guide: Guide) -> Self {
+        self.guide = Some(guide);
+        self
     }
 
     fn enter_segment(&mut self, t_a: f64, theta_a: f64, theta_b: f64) {
@@ -177,6 +188,9 @@ impl<'c, 'm> Flow<'c, 'm> {
                     }
                 }
             }
+        }
+        if let Some(guide) = &self.guide {
+            guide.acceleration_into(t, dv);
         }
         // Φ̃' = [[0, ω_s I], [-(M⁻¹K(t)/ω_s), -M⁻¹D(t)]] Φ̃: the lower block row by one
         // matrix product `-[B C] Φ̃` (n × 2n times 2n × 2n).

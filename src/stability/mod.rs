@@ -74,6 +74,7 @@ pub(crate) mod expm;
 mod exponential;
 mod flow;
 mod generator;
+mod guide;
 mod harmonic_orbit;
 mod integration;
 mod kept;
@@ -172,9 +173,9 @@ pub struct Floquet {
     /// (more than [`OTHER_ORBIT_DISTANCE`]) away, also when started again from the HB state,
     /// and with multipliers of another kind than the HB orbit's own (a strongly unstable
     /// orbit single shooting cannot hold, whose neighbour it glided onto). The multipliers are
-    /// then the HB orbit's own ([`Orbit::Harmonic`]). Only where the HB orbit's pieces apply
-    /// (every law piecewise affine along it); elsewhere [`Floquet::orbit_distance`] says how
-    /// far the exact orbit lies.
+    /// then the HB orbit's own ([`Orbit::Harmonic`]): from the exponential flow's pieces where
+    /// every law is piecewise affine along it, from the Runge–Kutta flow of the variational
+    /// equation along the HB orbit otherwise.
     #[serde(default)]
     pub other_orbit: Option<f64>,
 }

@@ -19,7 +19,7 @@
 use super::dispatch::FloquetCache;
 use super::shooting::{shoot, Goal, Start};
 use super::system::Coordinates;
-use super::{Floquet, FloquetOptions, Integrator, Orbit};
+use super::{Floquet, FloquetOptions, Orbit};
 use crate::error::Result;
 use crate::model::Model;
 use crate::solution::Solution;
@@ -88,11 +88,10 @@ pub fn orbit_distance(model: &Model, solution: &Solution, hb: &[f64], x: &[f64])
 impl FloquetOptions {
     /// Decides whose multipliers `found` (the exact orbit's, more than
     /// [`OTHER_ORBIT_DISTANCE`] from the HB orbit, [`Floquet::other_orbit`] set) should be:
-    /// where the HB orbit's pieces apply, its own multipliers are compared. The same kind (the
-    /// same stability and number of real multipliers above +1): the HB solution is merely
-    /// inaccurate (an under-resolved orbit, the two-shaft model at 60 rpm), `found` stands
-    /// without the mark. Another kind: the HB orbit's own, marked. Where the pieces do not
-    /// apply `found` stands without the mark (its [`Floquet::orbit_distance`] says how far).
+    /// the HB orbit's own multipliers are compared ([`FloquetOptions::hb_orbit`]). The same
+    /// kind (the same stability and number of real multipliers above +1): the HB solution is
+    /// merely inaccurate (an under-resolved orbit, the two-shaft model at 60 rpm), `found`
+    /// stands without the mark. Another kind: the HB orbit's own, marked.
     pub(super) fn own_multipliers(
         &self,
         sys: &Coordinates,
@@ -100,26 +99,21 @@ impl FloquetOptions {
         cache: &mut FloquetCache,
         mut found: Floquet,
     ) -> Result<Floquet> {
-        let own = match self.integrator {
-            Integrator::Auto if !cache.exact_only => Some(self.hb_orbit(sys, solution, cache)?),
-            _ => None,
-        };
-        match own {
-            Some(o) if o.orbit != Orbit::Harmonic => cache.exact_only = true,
-            Some(mut own) if !same_kind(&own, &found) => {
-                own.other_orbit = found.other_orbit;
-                own.steps += found.steps;
-                forget_orbit(cache);
-                return Ok(own);
-            }
-            _ => {}
+        let mut own = self.hb_orbit(sys, solution, cache)?;
+        if !same_kind(&own, &found) {
+            own.other_orbit = found.other_orbit;
+            own.steps += found.steps;
+            forget_orbit(cache);
+            return Ok(own);
         }
         found.other_orbit = None;
         Ok(found)
     }
 
-    /// The multipliers of the HB orbit's own pieces (the exact orbit's where they do not
-    /// apply).
+    /// The multipliers of the HB orbit itself, for every law: the exponential flow's pieces
+    /// where every law is affine between its kinks ([`harmonic_orbit`](super::harmonic_orbit)),
+    /// the Runge–Kutta flow of the variational equation along it otherwise
+    /// ([`guide`](super::guide)).
     pub(super) fn hb_orbit(
         &self,
         sys: &Coordinates,
@@ -135,7 +129,7 @@ impl FloquetOptions {
             solution,
             &harmonic,
             Start::Hb,
-            Goal::Exact,
+            Goal::Own,
             None,
             &mut cache.generators,
         )?;
@@ -150,7 +144,13 @@ pub(super) fn forget_orbit(cache: &mut FloquetCache) {
     cache.corrections.clear();
 }
 
-/// The same stability and the same number of real multipliers above +1.
+/// The same stability and the same number of real multipliers above +1, and, where both are
+/// unstable, leading moduli within a factor 2 of each other (on the frozen-stage car's middle
+/// branch with a cosine mesh stiffness a shooting found an orbit with 4.1 where the HB orbit's
+/// own leading multiplier is 1.1e11: another saddle).
 pub(super) fn same_kind(a: &Floquet, b: &Floquet) -> bool {
-    a.is_stable() == b.is_stable() && a.real_unstable() == b.real_unstable()
+    let unstable = !a.is_stable() && !b.is_stable();
+    a.is_stable() == b.is_stable()
+        && a.real_unstable() == b.real_unstable()
+        && !(unstable && (a.max_abs().ln() - b.max_abs().ln()).abs() > std::f64::consts::LN_2)
 }

@@ -6,6 +6,7 @@
 use super::chord::{iterate, KeptJacobian, Outcome, Problem};
 use super::exponential::ExpFlow;
 use super::flow::{Flow, FlowOptions};
+use super::guide::Guide;
 use super::integration::Integration;
 use super::kept::KeptGenerators;
 use super::scales::scales;
@@ -40,6 +41,10 @@ pub(crate) enum Goal<'a> {
         reference: &'a [Complex64],
         kappa: f64,
     },
+    /// No shooting: the multipliers of the HB orbit itself whatever the laws (with
+    /// [`Orbit::Harmonic`]), from the exponential flow's pieces where they apply and the
+    /// Runge–Kutta flow along the HB orbit ([`Guide`]) otherwise.
+    Own,
 }
 
 /// A Floquet analysis and the sensitivity of its multipliers to the orbit's start: `κ` =
@@ -90,14 +95,14 @@ pub(crate) fn shoot(
     };
     let (scale_q, omega_max, amplitudes) = scales(sys, solution, &harmonics);
     let scale_v = scale_q * omega_max;
+    let flow_options = || FlowOptions {
+        rtol: options.rtol,
+        h_max: 1.0 / omega_max,
+        max_steps: options.max_steps,
+    };
     let runge_kutta = || -> Result<Integration> {
-        let opts = FlowOptions {
-            rtol: options.rtol,
-            h_max: 1.0 / omega_max,
-            max_steps: options.max_steps,
-        };
         let flow = Flow::new(sys, omega, scale_q, scale_v, options.rtol)?;
-        Ok(Integration::runge_kutta(flow, opts, 2 * n))
+        Ok(Integration::runge_kutta(flow, flow_options(), 2 * n))
     };
     let mut flow = if options.integrator == Integrator::Auto
         && affine::piecewise_affine(sys.model, &amplitudes)
@@ -147,6 +152,7 @@ pub(crate) fn shoot(
     let jacobian = jacobian.and_then(|j| j.in_scales(sys, (scale_q, scale_v)));
     // The HB orbit's own pieces: no integration, nothing to polish (unless a law turns out
     // not to be affine along it).
+    let mut earlier_steps = 0;
     let along = match &mut flow {
         Integration::Exponential { flow, record } if options.orbit == Orbit::Harmonic => {
             let all = &solution.harmonics()[..(h + 1) * n_model];
@@ -160,6 +166,21 @@ pub(crate) fn shoot(
         }
         _ => None,
     };
+    // Laws that are not piecewise affine: the Runge–Kutta flow along the HB orbit.
+    let along = match along {
+        None if matches!(goal, Goal::Own) && options.orbit == Orbit::Harmonic => {
+            let fundamental = solution.basis().fundamental();
+            let guide = Guide::new(&harmonics, n, fundamental);
+            let guided = Flow::new(sys, omega, scale_q, scale_v, options.rtol)?.along(guide);
+            let earlier = flow.steps();
+            flow = Integration::runge_kutta(guided, flow_options(), 2 * n);
+            let mut x = x0.clone();
+            flow.pass(&mut x, solution.basis().subharmonic())?;
+            earlier_steps = earlier;
+            Some(flow.monodromy()?)
+        }
+        a => a,
+    };
     let harmonic = along.is_some();
     let outcome = match along {
         Some(phi) => Outcome {
@@ -167,7 +188,7 @@ pub(crate) fn shoot(
             polished: false,
             ahead: None,
             kappa: None,
-            earlier_steps: 0,
+            earlier_steps,
         },
         None => iterate(&problem, &mut flow, &runge_kutta, &mut x0, jacobian)?,
     };

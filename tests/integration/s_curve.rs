@@ -260,3 +260,33 @@ fn crank_fundamental_run_up_keeps_multipliers_on_the_reported_orbits() {
     // outer branches, whose HB states stay near their orbits.
     time_checks(&scene, &branch, folds, 30, &[0.5], true);
 }
+
+/// The same drivetrain with a cosine mesh stiffness: not affine between its kinks, so the
+/// exponential flow's pieces do not apply, and before the HB orbit's own multipliers came
+/// from Runge–Kutta along it (`stability/guide.rs`) the middle branch was labelled stable
+/// (shooting glided onto the outer orbits, up to 2.4 of the dynamic range away) with both
+/// turns spurious.
+#[test]
+#[ignore = "release: a sweep of 95 points with 128 harmonics and Runge–Kutta shooting"]
+fn smooth_mesh_stiffness_run_up_takes_the_hb_orbits_own_multipliers() {
+    let (scene, branch) = sweep(
+        "tests/data/s_curve/car_drivetrain_stage2_frozen_cosine.toml",
+        3100.0,
+        9000.0,
+    );
+    let folds = folds(&scene, &branch, 0);
+    assert!((folds[0].1 - 4928.5).abs() < 5.0, "{folds:?}");
+    assert!((folds[1].1 - 3250.4).abs() < 5.0, "{folds:?}");
+    assert_eq!(branch.spurious_turns(), 0);
+    let (a, b) = (folds[0].0, folds[1].0);
+    let own: Vec<f64> = branch.points[a..b]
+        .iter()
+        .filter_map(|p| p.floquet.as_ref())
+        .filter(|f| f.other_orbit.is_some())
+        .inspect(|f| assert_eq!(f.orbit, hbal::stability::Orbit::Harmonic))
+        .map(|f| f.max_abs())
+        .collect();
+    assert!(own.len() * 4 >= (b - a) * 3, "{} of {}", own.len(), b - a);
+    assert!(own.iter().copied().fold(0.0, f64::max) > 1e10, "{own:?}");
+    time_checks(&scene, &branch, folds, 30, &[0.5], true);
+}

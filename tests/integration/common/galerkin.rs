@@ -109,6 +109,40 @@ pub fn force_harmonics(
 /// `(-(kΩ)² M + ikΩ D + K) Q_k + Σ_e w_e F_{e,k} - L_k = 0`, `k = 0..=H`, at the harmonics `q`
 /// (harmonic-major, ν = 1), with the element forces from [`force_harmonics`].
 pub fn residual_relative_to_load(model: &Model, omega: f64, q: &[Complex64]) -> f64 {
+    let (r, loads) = residual(model, omega, q);
+    let largest = loads.iter().map(|l| l.norm()).fold(0.0, f64::max);
+    r.iter().map(|c| c.norm()).fold(0.0, f64::max) / largest
+}
+
+/// The same residual in the Parseval norm `sqrt(Σ_i |R_0i|² + ½ Σ_{k≥1} |R_ki|²)` relative
+/// to the load's (what hbal's relative residuals use).
+pub fn parseval_residual_relative_to_load(model: &Model, omega: f64, q: &[Complex64]) -> f64 {
+    let n = model.n_dofs();
+    let parseval = |v: &[Complex64]| {
+        v.iter()
+            .enumerate()
+            .map(|(j, c)| {
+                if j < n {
+                    c.norm_sqr()
+                } else {
+                    0.5 * c.norm_sqr()
+                }
+            })
+            .sum::<f64>()
+            .sqrt()
+    };
+    let (r, _) = residual(model, omega, q);
+    let mut load = vec![Complex64::default(); q.len()];
+    for l in model.loads() {
+        if l.order * n + l.dof < load.len() {
+            load[l.order * n + l.dof] += hbal::harmonic::from_cos_sin(l.cos, l.sin);
+        }
+    }
+    parseval(&r) / parseval(&load)
+}
+
+/// The Galerkin residual `R_k` (harmonic-major) and the loads.
+fn residual(model: &Model, omega: f64, q: &[Complex64]) -> (Vec<Complex64>, Vec<Complex64>) {
     let n = model.n_dofs();
     let h = q.len() / n - 1;
     let mut r = vec![Complex64::default(); q.len()];
@@ -136,13 +170,13 @@ pub fn residual_relative_to_load(model: &Model, omega: f64, q: &[Complex64]) -> 
             }
         }
     }
-    let mut largest: f64 = 0.0;
+    let mut loads = Vec::new();
     for l in model.loads() {
         let load = hbal::harmonic::from_cos_sin(l.cos, l.sin);
-        largest = largest.max(load.norm());
+        loads.push(load);
         if l.order <= h {
             r[l.order * n + l.dof] -= load;
         }
     }
-    r.iter().map(|c| c.norm()).fold(0.0, f64::max) / largest
+    (r, loads)
 }

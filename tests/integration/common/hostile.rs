@@ -91,11 +91,12 @@ pub enum Breach {
 }
 
 /// Keys whose value may be `null` by the documented schema (docs/scenes.md).
-const NULLABLE: [&str; 7] = [
+const NULLABLE: [&str; 8] = [
     "auto_harmonics",
     "error_estimate",
     "gear_stage",
     "other_orbit",
+    "quadrature",
     "reduction",
     "stability",
     "start",
