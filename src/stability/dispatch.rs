@@ -6,10 +6,11 @@
 use super::chord::KeptJacobian;
 use super::kept::KeptGenerators;
 use super::orbit_check::OrbitCheck;
+use super::orbit_identity::other_orbit_threshold;
 use super::reduction::{reduced_basis, ModeCache};
 use super::shooting::{distance, hb_start, shoot, Goal, Shot, Start};
 use super::system::Coordinates;
-use super::{Floquet, FloquetOptions, Orbit, OTHER_ORBIT_DISTANCE};
+use super::{Floquet, FloquetOptions, Orbit};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solution::Solution;
@@ -201,7 +202,7 @@ impl FloquetOptions {
             )?;
             if s.floquet.polished
                 && s.floquet.orbit_correction <= PREDICTED_ORBIT_DISTANCE
-                && s.floquet.orbit_distance <= OTHER_ORBIT_DISTANCE
+                && s.floquet.orbit_distance <= other_orbit_threshold(solution)
             {
                 shot = Some(s);
             }
@@ -224,7 +225,7 @@ impl FloquetOptions {
             mut floquet, kappa, ..
         } = shot;
         // Possibly another orbit: the caller decides ([`FloquetOptions::own_multipliers`]).
-        if floquet.orbit_distance > OTHER_ORBIT_DISTANCE {
+        if floquet.orbit_distance > other_orbit_threshold(solution) {
             floquet.other_orbit = Some(floquet.orbit_distance);
         }
         cache.kappa = kappa.or(cache.kappa);

@@ -170,7 +170,7 @@ pub struct Floquet {
     #[serde(default)]
     pub orbit_distance: f64,
     /// `Some(d)` where the shooting found another periodic orbit than the HB solution's: `d`
-    /// (more than [`OTHER_ORBIT_DISTANCE`]) away, also when started again from the HB state,
+    /// (more than [`OTHER_ORBIT_DISTANCE`], or four times the HB solution's truncation estimate where that is larger) away, also when started again from the HB state,
     /// and with multipliers of another kind than the HB orbit's own (a strongly unstable
     /// orbit single shooting cannot hold, whose neighbour it glided onto). The multipliers are
     /// then the HB orbit's own ([`Orbit::Harmonic`]): from the exponential flow's pieces where

@@ -85,6 +85,27 @@ pub fn orbit_distance(model: &Model, solution: &Solution, hb: &[f64], x: &[f64])
     }
 }
 
+/// How many times its truncation estimate the HB solution may lie from the exact orbit it
+/// stands for ([`other_orbit_threshold`]).
+const TRUNCATION_FACTOR: f64 = 4.0;
+
+/// The [`orbit_distance`] beyond which a shooting's orbit is taken for another orbit than the
+/// HB solution's: [`OTHER_ORBIT_DISTANCE`], or [`TRUNCATION_FACTOR`] times the solution's
+/// [truncation estimate](Solution::truncation_estimate) where that is larger. An HB solution
+/// whose top harmonics are not small may lie that far from its own exact orbit, and the
+/// linearisation about it is then no better: a Duffing oscillator at H = 1 (truncation
+/// estimate 1) lies 8e-3 to 3e-2 from the exact middle-branch orbits, whose multipliers
+/// (unstable) are right where the HB orbit's own (stable) are not. The S-shaped run-ups at
+/// H = 128 have estimates of 2e-5 to 2e-3 and other orbits from 8e-3 on.
+pub(super) fn other_orbit_threshold(solution: &Solution) -> f64 {
+    let t = solution.truncation_estimate();
+    if t.is_finite() {
+        OTHER_ORBIT_DISTANCE.max(TRUNCATION_FACTOR * t)
+    } else {
+        OTHER_ORBIT_DISTANCE
+    }
+}
+
 impl FloquetOptions {
     /// Decides whose multipliers `found` (the exact orbit's, more than
     /// [`OTHER_ORBIT_DISTANCE`] from the HB orbit, [`Floquet::other_orbit`] set) should be:
