@@ -89,16 +89,25 @@ pub(crate) fn compare(
     let mut rows = Vec::new();
     let mut histories = Vec::new();
     let mut any_converged = false;
+    let samples = td.samples.first().map_or(0, |s| s.len());
     for (name, seconds, sol) in &solutions {
         let error = model_relative_error(&scene.model, sol.harmonics(), &td.harmonics, h);
+        // The exact method by its closed form in time, with the ringing above H.
+        let series = (*name == "piecewise_exact")
+            .then(|| {
+                hbal::solve::PiecewiseExact::new()
+                    .solve_exact(&scene.model, &basis)
+                    .and_then(|e| e.series_harmonics(samples))
+                    .ok()
+            })
+            .flatten();
         // Per quantity, against the time domain's samples (all its harmonics, not only 0..H).
         let worst = (basis.subharmonic() == 1)
             .then(|| {
-                let samples = td.samples.first().map_or(0, |s| s.len());
                 hbal::compare::quantity_errors(
                     &scene.model,
                     &basis,
-                    sol.harmonics(),
+                    series.as_deref().unwrap_or(sol.harmonics()),
                     &td.harmonics,
                     samples,
                 )

@@ -91,7 +91,7 @@ pub enum Breach {
 }
 
 /// Keys whose value may be `null` by the documented schema (docs/scenes.md).
-const NULLABLE: [&str; 8] = [
+const NULLABLE: [&str; 10] = [
     "auto_harmonics",
     "error_estimate",
     "gear_stage",
@@ -100,6 +100,8 @@ const NULLABLE: [&str; 8] = [
     "reduction",
     "stability",
     "start",
+    "worst_force",
+    "worst_quantity",
 ];
 
 /// Judges a run of `hbal check` (`json = false`) or `hbal solve --json` (`json = true`).
