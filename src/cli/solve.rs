@@ -55,6 +55,8 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     }
     let started = Instant::now();
     let solve_seconds;
+    // The path that found the orbit where the scene's method alone did not.
+    let mut found_by: Option<String> = None;
     let mut exact = None;
     // Automatic harmonics handed over to the exact piecewise solution at the cap.
     let mut switched = false;
@@ -70,6 +72,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             let a = hbal::solve::solve_auto(&scene.model, scene.basis, &scene.method, auto)
                 .map_err(|e| super::failure(e, &scene.file))?;
             solve_seconds = started.elapsed().as_secs_f64();
+            found_by = a.found_by;
             exact = a.exact;
             switched = a.switched_to_exact;
             (
@@ -96,11 +99,21 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         None => {
             let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
                 .with_context(|| scene.file.clone())?;
-            let mut ws = hb.workspace();
-            let sol = scene
-                .method
-                .solve(&hb, start.as_ref().map(|s| s.harmonics.as_slice()), &mut ws)
-                .map_err(|e| super::failure(e, &scene.file))?;
+            // The scene's method, and where it fails the others, the load homotopy and
+            // continuation in the speed (named in the output).
+            let continuation = hbal::continuation::Continuation {
+                method: scene.method,
+                formulation: args.formulation,
+                ..Default::default()
+            };
+            let (sol, how) = hbal::continuation::solve_with_fallbacks(
+                &scene.model,
+                scene.basis,
+                &continuation,
+                start.as_ref().map(|s| s.harmonics.as_slice()),
+            )
+            .map_err(|e| super::failure(e, &scene.file))?;
+            found_by = how;
             solve_seconds = started.elapsed().as_secs_f64();
             // The error of the harmonics, against the solution with 2H (module
             // hbal::solve::accuracy); none for an unconverged iterate.
@@ -186,6 +199,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             "termination": sol.termination.to_string(),
             "method": if switched { "piecewise_exact" } else { scene.method.name() },
             "switched_to_exact": switched,
+            "found_by": found_by,
             "iterations": sol.stats.iterations,
             "residual": sol.residual(),
             "truncation_estimate": sol.truncation_estimate(),
@@ -233,12 +247,14 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             sol.termination,
             if switched {
                 "piecewise_exact"
+            } else if found_by.is_some() && sol.is_converged() {
+                "by a fallback, below"
             } else {
                 scene.method.name()
             },
             sol.stats.iterations,
             if sol.stats.iterations == 1 { "" } else { "s" },
-            if start.is_some() && exact.is_none() {
+            if start.is_some() && exact.is_none() && found_by.is_none() {
                 " from --start"
             } else {
                 ""
@@ -246,6 +262,9 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             sol.residual(),
             solve_seconds * 1e3
         );
+        if let Some(how) = &found_by {
+            say!("  {how}");
+        }
         say!(
             "  fundamental {:.6} rad/s, H = {}, N = {}, {}",
             sol.basis().omega(),

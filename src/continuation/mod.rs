@@ -30,7 +30,7 @@ mod switch;
 
 pub use parameter::{parameter_sweep, sweep_values};
 pub use point::TurnEvidence;
-pub use speed_homotopy::solve_robustly;
+pub use speed_homotopy::{solve_robustly, solve_with_fallbacks};
 
 use crate::solve::{Method, Newton};
 use crate::stability::{Bifurcation, Floquet, FloquetOptions};

@@ -12,6 +12,49 @@ use crate::residual::HarmonicBalance;
 use crate::solution::Solution;
 use crate::solve::{robust_start, StartReport};
 use crate::HarmonicBasis;
+use num_complex::Complex64;
+
+/// `continuation.method` from `initial` (the linear solution if `None`), and where that does
+/// not converge [`solve_robustly`]: the solution and, where the method alone did not find it,
+/// the path that did ([`StartReport::how`]). Every path failing: the method's own result
+/// with the paths named.
+pub fn solve_with_fallbacks(
+    model: &Model,
+    basis: HarmonicBasis,
+    continuation: &Continuation,
+    initial: Option<&[Complex64]>,
+) -> Result<(Solution, Option<String>)> {
+    let hb = HarmonicBalance::with_formulation(model, basis, continuation.formulation)?;
+    let mut ws = hb.workspace();
+    let own = continuation.method.solve(&hb, initial, &mut ws)?;
+    if own.is_converged() {
+        return Ok((own, None));
+    }
+    let robust = solve_robustly(model, basis, continuation)?;
+    let from = if initial.is_some() {
+        "from the given start"
+    } else {
+        "from the linear solution"
+    };
+    let failed = format!(
+        "{} failed {from} ({})",
+        continuation.method.name(),
+        own.termination
+    );
+    if robust.solution.is_converged() {
+        Ok((
+            robust.solution,
+            Some(format!("{failed}; found by {}", robust.how)),
+        ))
+    } else {
+        Ok((
+            own,
+            Some(format!(
+                "{failed}; so did the other solvers, the load homotopy and the speed homotopy"
+            )),
+        ))
+    }
+}
 
 /// [`robust_start`], then continuation in the speed from far away. `continuation` supplies the
 /// method, the tolerance and the step limits.
@@ -52,6 +95,22 @@ pub fn solve_robustly(
         if last.omega != omega {
             continue;
         }
+        // Where the branch turned on the way, other orbits coexist between: which one the
+        // solution is depends on the side it came from, and the report says so.
+        let turns = branch
+            .points
+            .windows(3)
+            .filter(|w| (w[1].omega - w[0].omega) * (w[2].omega - w[1].omega) < 0.0)
+            .count();
+        let turned = if turns > 0 {
+            format!(
+                "; the branch turned {turns} time{} on the way: other orbits may coexist at this speed, this one is reached from {}",
+                if turns == 1 { "" } else { "s" },
+                if factor < 1.0 { "below" } else { "above" }
+            )
+        } else {
+            String::new()
+        };
         return Ok(StartReport {
             solution: Solution::from_harmonics(
                 basis,
@@ -60,7 +119,7 @@ pub fn solve_robustly(
                 last.residual,
             )?,
             how: format!(
-                "speed homotopy from {:.6} rad/s ({} points)",
+                "speed homotopy from {:.6} rad/s ({} points){turned}",
                 omega * factor,
                 branch.points.len()
             ),

@@ -27,7 +27,7 @@ use crate::residual::HarmonicBalance;
 use crate::solution::Solution;
 use crate::solve::coarse::coarse_harmonics;
 use crate::solve::ringing::{reference, rings_beyond};
-use crate::solve::{robust_start, Method, Newton};
+use crate::solve::{Method, Newton};
 use crate::{Formulation, HarmonicBasis};
 use std::time::Instant;
 
@@ -70,7 +70,7 @@ pub struct ErrorEstimate {
 
 /// The basis with `harmonics` harmonics at the Ω and ν of `basis`, with as many samples per
 /// harmonic as it has (at least the default).
-fn scaled(basis: &HarmonicBasis, harmonics: usize) -> Result<HarmonicBasis> {
+pub(super) fn scaled(basis: &HarmonicBasis, harmonics: usize) -> Result<HarmonicBasis> {
     let b = HarmonicBasis::new(basis.omega(), harmonics)?.with_tail_correction_of(basis);
     let per = basis.samples() as f64 / basis.harmonics().max(1) as f64;
     let n = ((per * harmonics as f64).ceil() as usize).max(b.samples());
@@ -316,6 +316,10 @@ pub struct AutoSolution {
     /// admits the exact piecewise solution, which reached it: `solution` is that one, and
     /// `levels` holds harmonic balance's levels and then the exact method's.
     pub switched_to_exact: bool,
+    /// The path that found the first level's solution where the method alone did not from
+    /// the linear solution (the other solvers, the load or speed homotopy, a higher H), with
+    /// what failed before; `None` where it did.
+    pub found_by: Option<String>,
 }
 
 /// Solves `model` at H = H0, 2 H0, ... from `basis` (its Ω, its H as H0 and its samples per
@@ -368,9 +372,9 @@ pub fn solve_auto(
     }
     let mut level_basis = scaled(&basis, basis.harmonics().max(1))?;
     let started = Instant::now();
-    let mut hb = HarmonicBalance::with_formulation(model, level_basis, auto.formulation)?;
-    let mut ws = hb.workspace();
-    let mut current = robust_start(&mut hb, method, None, 1e-10, &mut ws)?.solution;
+    let (mut current, found_by) =
+        super::auto_start::first_level(model, level_basis, method, &auto)?;
+    level_basis = *current.basis();
     let mut levels = Vec::new();
     loop {
         if !current.is_converged() {
@@ -408,6 +412,7 @@ pub fn solve_auto(
                 capped,
                 exact: None,
                 switched_to_exact: false,
+                found_by,
             });
         }
         current = if fine.basis().harmonics() <= auto.max_harmonics {
@@ -484,6 +489,7 @@ fn auto_exact(
                 capped,
                 exact: Some(e),
                 switched_to_exact: false,
+                found_by: None,
             });
         }
         level_basis = scaled(&level_basis, next)?;

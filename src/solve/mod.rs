@@ -8,6 +8,7 @@
 
 mod accuracy;
 mod anderson;
+mod auto_start;
 mod broyden;
 pub mod coarse;
 mod fixed_point;

@@ -34,6 +34,7 @@ mod force_laws;
 mod free_free;
 mod free_free_time_domain;
 mod gear_stage;
+mod globalised_solve;
 mod hard_cases;
 mod hostile_input;
 mod hostile_non_finite;
