@@ -35,6 +35,10 @@ enum Command {
         /// Skip the Floquet stability of the converged orbit.
         #[arg(long)]
         no_stability: bool,
+        /// The scene's method alone, its result reported converged or not (exit code 1): no
+        /// fallback to the other solvers, the load homotopy or continuation in the speed.
+        #[arg(long)]
+        no_fallback: bool,
         /// Print exactly one JSON object on stdout instead of the summary.
         #[arg(long)]
         json: bool,
@@ -210,6 +214,7 @@ fn main() -> ExitCode {
             solver,
             start,
             no_stability,
+            no_fallback,
             json,
             out,
         } => cli::solve::solve(
@@ -218,6 +223,7 @@ fn main() -> ExitCode {
             cli::solve::SolveOptions {
                 start: start.as_deref(),
                 stability: !no_stability,
+                fallback: !no_fallback,
                 json,
                 out: out.as_deref(),
                 capture: None,

@@ -68,6 +68,7 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
             solve::SolveOptions {
                 start: None,
                 stability: opts.stability,
+                fallback: true,
                 json: true,
                 out: Some(&dir.join("solve")),
                 capture: Some(doc),

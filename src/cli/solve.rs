@@ -16,6 +16,8 @@ use std::time::Instant;
 pub(crate) struct SolveOptions<'a> {
     pub(crate) start: Option<&'a Path>,
     pub(crate) stability: bool,
+    /// Fall back to the other solvers and homotopies where the scene's method fails.
+    pub(crate) fallback: bool,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
     /// Keep the JSON document here instead of printing anything (for `hbal report`).
@@ -106,12 +108,18 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 formulation: args.formulation,
                 ..Default::default()
             };
-            let (sol, how) = hbal::continuation::solve_with_fallbacks(
-                &scene.model,
-                scene.basis,
-                &continuation,
-                start.as_ref().map(|s| s.harmonics.as_slice()),
-            )
+            let initial = start.as_ref().map(|s| s.harmonics.as_slice());
+            let (sol, how) = if opts.fallback {
+                hbal::continuation::solve_with_fallbacks(
+                    &scene.model,
+                    scene.basis,
+                    &continuation,
+                    initial,
+                )
+            } else {
+                let mut ws = hb.workspace();
+                scene.method.solve(&hb, initial, &mut ws).map(|s| (s, None))
+            }
             .map_err(|e| super::failure(e, &scene.file))?;
             found_by = how;
             solve_seconds = started.elapsed().as_secs_f64();

@@ -11,6 +11,13 @@ use crate::residual::HarmonicBalance;
 use crate::solve::robust_start;
 use crate::HarmonicBasis;
 use num_complex::Complex64;
+
+/// A step that turned the tangent by less than this (rad) grows unless the corrector needed
+/// more than five iterations.
+const FLAT_ANGLE: f64 = 0.1;
+
+/// A step that turned the tangent by more than this (rad) shrinks.
+const SHARP_ANGLE: f64 = 0.3;
 use std::sync::mpsc::sync_channel;
 
 /// Where a branch is followed: it lands exactly on `to` and stops there; with `back`, also on
@@ -328,13 +335,29 @@ impl Continuation {
             if rejoined {
                 return Some(BranchStop::Rejoined { omega });
             }
-            if iterations <= 2 {
-                step = (step * 1.5).min(self.max_step);
-            } else if iterations >= 5 {
-                step *= 0.7;
-            }
+            step = self.next_step(step, iterations, &t_prev, &t);
         }
         None
+    }
+
+    /// The next step from the corrector's `iterations` and the angle between the last two
+    /// tangents: the branch's geometry. A step that turned the tangent by less than
+    /// [`FLAT_ANGLE`] grows even where the corrector needed several iterations (a stiff
+    /// contact opening or closing costs iterations, not curvature); one that turned it by
+    /// more than [`SHARP_ANGLE`] shrinks even where the corrector was quick.
+    fn next_step(&self, step: f64, iterations: usize, t_prev: &[f64], t: &[f64]) -> f64 {
+        let cos: f64 = t_prev.iter().zip(t).map(|(a, b)| a * b).sum();
+        let angle = cos.clamp(-1.0, 1.0).acos();
+        let grow = if angle < FLAT_ANGLE { 5 } else { 2 };
+        if angle > SHARP_ANGLE {
+            step * 0.7
+        } else if iterations <= grow {
+            (step * 1.5).min(self.max_step)
+        } else if iterations >= 5 && angle >= FLAT_ANGLE {
+            step * 0.7
+        } else {
+            step
+        }
     }
 
     /// Appends the point `x` at `omega` (on the basis of `hb`); `Some(reason)` if its

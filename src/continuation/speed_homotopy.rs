@@ -14,6 +14,9 @@ use crate::solve::{robust_start, StartReport};
 use crate::HarmonicBasis;
 use num_complex::Complex64;
 
+/// Points of one continuation from a far speed at most.
+const HOMOTOPY_POINTS: usize = 400;
+
 /// `continuation.method` from `initial` (the linear solution if `None`), and where that does
 /// not converge [`solve_robustly`]: the solution and, where the method alone did not find it,
 /// the path that did ([`StartReport::how`]). Every path failing: the method's own result
@@ -76,9 +79,12 @@ pub fn solve_robustly(
         return Ok(direct);
     }
     let omega = basis.omega();
+    // A bounded effort per start speed: a scene that defeats every solver should not run
+    // four sweeps of the user's point limit before it is told so.
     let inner = Continuation {
         stability: None,
         error_estimate: false,
+        max_points: continuation.max_points.min(HOMOTOPY_POINTS),
         ..*continuation
     };
     for factor in [0.5, 2.0, 0.25, 4.0] {

@@ -104,6 +104,7 @@ fn non_converged_solve_exits_1_with_its_result() {
         "--json",
         "--method",
         "fixed_point",
+        "--no-fallback",
     ]);
     assert_eq!(out.status.code(), Some(1));
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();

@@ -68,7 +68,14 @@ fn solve_reports_floquet_stability() {
     let out = hbal(&["solve", w08.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("  stability: unstable, max |μ| = 2.11"));
     // An unconverged solve has no orbit to judge.
-    let out = hbal(&["solve", p, "--json", "--method", "fixed_point"]);
+    let out = hbal(&[
+        "solve",
+        p,
+        "--json",
+        "--method",
+        "fixed_point",
+        "--no-fallback",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(json_of(&out)["stability"], serde_json::Value::Null);
 }

@@ -271,7 +271,13 @@ fn unconverged_outputs_say_so() {
     std::fs::write(&scene, text).unwrap();
     let run = |out: &str| {
         std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
-            .args(["solve", scene.to_str().unwrap(), "--no-stability", "--out"])
+            .args([
+                "solve",
+                scene.to_str().unwrap(),
+                "--no-stability",
+                "--no-fallback",
+                "--out",
+            ])
             .arg(dir.join(out))
             .output()
             .unwrap()

@@ -91,9 +91,10 @@ pub enum Breach {
 }
 
 /// Keys whose value may be `null` by the documented schema (docs/scenes.md).
-const NULLABLE: [&str; 10] = [
+const NULLABLE: [&str; 11] = [
     "auto_harmonics",
     "error_estimate",
+    "found_by",
     "gear_stage",
     "other_orbit",
     "quadrature",
