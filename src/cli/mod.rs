@@ -29,6 +29,7 @@ pub(crate) mod element_report;
 pub(crate) mod modes;
 pub(crate) mod order_cuts;
 pub(crate) mod parameter_sweep;
+pub(crate) mod progress;
 mod quantity_report;
 pub(crate) mod report;
 pub(crate) mod report_html;

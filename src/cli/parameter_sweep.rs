@@ -90,10 +90,7 @@ pub(crate) fn parameter_sweep(
         }
         None => None,
     };
-    let bar = indicatif::ProgressBar::new(points as u64);
-    if as_json {
-        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
+    let bar = super::progress::Progress::new("parameter sweep", as_json);
     let start = Instant::now();
     let branch = parameter_sweep(
         &values,
@@ -116,13 +113,13 @@ pub(crate) fn parameter_sweep(
         opts.stability
             .then(hbal::stability::FloquetOptions::default),
         opts.solver.formulation,
-        |f| bar.set_position((f * points as f64) as u64),
+        |f| bar.set(f),
     )
     .map_err(|e| Failure {
         code: super::exit_code(&e),
         error: anyhow::Error::new(e).context(file.clone()),
     })?;
-    bar.finish_and_clear();
+    bar.finish();
     let seconds = start.elapsed().as_secs_f64();
     if as_json {
         let pts: Vec<_> = branch

@@ -77,12 +77,10 @@ fn run_auto(
     to: f64,
     initial: &[Complex64],
     auto: hbal::solve::AutoHarmonics,
-    bar: &indicatif::ProgressBar,
+    bar: &super::progress::Progress,
 ) -> Result<(Branch, HarmonicBasis), Failure> {
     let mut segments = continuation
-        .run_auto(&scene.model, basis, to, Some(initial), auto, |f| {
-            bar.set_position((f * 1000.0) as u64)
-        })
+        .run_auto(&scene.model, basis, to, Some(initial), auto, |f| bar.set(f))
         .map_err(|e| super::sweep_failure(e, &scene.file))?;
     let mut branch = segments.remove(0);
     let mut steps = vec![format!("H = {}", branch.harmonics)];
@@ -214,14 +212,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             auto_start = Some((auto, a.solution.harmonics().to_vec()));
         }
     }
-    let bar = indicatif::ProgressBar::new(1000);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {percent:>3}% {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    if as_json {
-        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
+    let bar = super::progress::Progress::new("sweep", as_json);
     let defaults = Continuation::default();
     let continuation = Continuation {
         max_step,
@@ -252,20 +243,20 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             to * per,
             start.as_ref().map(|s| s.harmonics.as_slice()),
             opts.points,
-            |f| bar.set_position((f * 1000.0) as u64),
+            |f| bar.set(f),
         )
         .map_err(|e| super::sweep_failure(e, &scene.file))?,
     };
     let (lo, hi) = (from.min(to) * per, from.max(to) * per);
     let secondary = if opts.all_branches {
-        bar.set_message("switching branches");
+        bar.message("switching branches");
         continuation
             .switch_branches(&scene.model, basis, &branch, lo, hi)
             .map_err(|e| super::sweep_failure(e, &scene.file))?
     } else {
         Vec::new()
     };
-    bar.finish_and_clear();
+    bar.finish();
     let seconds = started.elapsed().as_secs_f64();
     let speed = |omega: f64| omega / per;
     // The library never gives a non-finite multiplier; should it, that is a failure, not `null`.

@@ -16,8 +16,14 @@ use num_complex::Complex64;
 /// more than five iterations.
 const FLAT_ANGLE: f64 = 0.1;
 
-/// A step that turned the tangent by more than this (rad) shrinks.
-const SHARP_ANGLE: f64 = 0.3;
+/// The angle (rad) between two unit tangents.
+fn turned(a: &[f64], b: &[f64]) -> f64 {
+    let cos: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    cos.clamp(-1.0, 1.0).acos()
+}
+
+/// A step that turned the tangent by more than this (rad) is taken again at half the length.
+const SHARP_ANGLE: f64 = 0.4;
 use std::sync::mpsc::sync_channel;
 
 /// Where a branch is followed: it lands exactly on `to` and stops there; with `back`, also on
@@ -219,6 +225,8 @@ impl Continuation {
         let (from, to) = (omega, range.to);
         let direction = if to >= from { 1.0 } else { -1.0 };
         let mut step = self.initial_step;
+        // The tangent's turn of the last step taken again at half the length.
+        let mut rejected: Option<f64> = None;
         let mut left_parent = false;
         let (mut xp, mut x_new) = (vec![0.0; m], vec![0.0; m]);
         let mut land_row = vec![0.0; m + 1];
@@ -245,6 +253,19 @@ impl Continuation {
             // after chord steps at the iterate where Ω was kept: a predictor either way).
             let t_prev = t.clone();
             tangent(&mut tr.b, &mut t);
+            // A step that turned the tangent too far is taken again at half the length: turns
+            // are bracketed by steps the tangent follows (an S-curve's corner located to a few
+            // rpm, not the 60 rpm of one long step across it).
+            // A corner of the branch (the tangent turns as far at half the step) is accepted.
+            let angle = turned(&t_prev, &t);
+            let corner = rejected.is_some_and(|a| angle > 0.7 * a);
+            if angle > SHARP_ANGLE && !corner && step > 4.0 * self.min_step {
+                t.copy_from_slice(&t_prev);
+                step *= 0.5;
+                rejected = Some(angle);
+                continue;
+            }
+            rejected = None;
             let turn = t_prev[m] * t[m] < 0.0;
             let turn_omega = turn.then(|| {
                 let h = tr.distance(&x_new, o_new, &x, omega);
@@ -346,13 +367,14 @@ impl Continuation {
     /// contact opening or closing costs iterations, not curvature); one that turned it by
     /// more than [`SHARP_ANGLE`] shrinks even where the corrector was quick.
     fn next_step(&self, step: f64, iterations: usize, t_prev: &[f64], t: &[f64]) -> f64 {
-        let cos: f64 = t_prev.iter().zip(t).map(|(a, b)| a * b).sum();
-        let angle = cos.clamp(-1.0, 1.0).acos();
+        let angle = turned(t_prev, t);
         let grow = if angle < FLAT_ANGLE { 5 } else { 2 };
         if angle > SHARP_ANGLE {
             step * 0.7
         } else if iterations <= grow {
-            (step * 1.5).min(self.max_step)
+            // Nearly straight: double.
+            let factor = if angle < 0.25 * FLAT_ANGLE { 2.0 } else { 1.5 };
+            (step * factor).min(self.max_step)
         } else if iterations >= 5 && angle >= FLAT_ANGLE {
             step * 0.7
         } else {

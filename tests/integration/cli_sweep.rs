@@ -431,3 +431,44 @@ fn sweep_raises_harmonics_along_the_branch() {
     assert!(worst > 0.0 && worst <= 1e-6, "{worst:e}");
     std::fs::remove_file(&p).ok();
 }
+
+/// Where stderr is not a terminal (a log file, CI) a sweep prints plain progress lines (every
+/// 10 s by default; `HBAL_PROGRESS_EVERY` seconds here 0: every update).
+#[test]
+fn progress_lines_where_stderr_is_not_a_terminal() {
+    let scene =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/duffing.toml");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args([
+            "sweep",
+            scene.to_str().unwrap(),
+            "--to",
+            "2",
+            "--no-stability",
+        ])
+        .env("HBAL_PROGRESS_EVERY", "0")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("progress: sweep "))
+        .collect();
+    assert!(lines.len() > 3, "{err}");
+    assert!(lines.last().unwrap().contains("100 %"), "{err}");
+    // With --json nothing but the document.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args([
+            "sweep",
+            scene.to_str().unwrap(),
+            "--to",
+            "2",
+            "--no-stability",
+            "--json",
+        ])
+        .env("HBAL_PROGRESS_EVERY", "0")
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("progress:"));
+}
