@@ -11,19 +11,6 @@ use crate::residual::HarmonicBalance;
 use crate::solve::robust_start;
 use crate::HarmonicBasis;
 use num_complex::Complex64;
-
-/// A step that turned the tangent by less than this (rad) grows unless the corrector needed
-/// more than five iterations.
-const FLAT_ANGLE: f64 = 0.1;
-
-/// The angle (rad) between two unit tangents.
-fn turned(a: &[f64], b: &[f64]) -> f64 {
-    let cos: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
-    cos.clamp(-1.0, 1.0).acos()
-}
-
-/// A step that turned the tangent by more than this (rad) is taken again at half the length.
-const SHARP_ANGLE: f64 = 0.4;
 use std::sync::mpsc::sync_channel;
 
 /// Where a branch is followed: it lands exactly on `to` and stops there; with `back`, also on
@@ -225,8 +212,6 @@ impl Continuation {
         let (from, to) = (omega, range.to);
         let direction = if to >= from { 1.0 } else { -1.0 };
         let mut step = self.initial_step;
-        // The tangent's turn of the last step taken again at half the length.
-        let mut rejected: Option<f64> = None;
         let mut left_parent = false;
         let (mut xp, mut x_new) = (vec![0.0; m], vec![0.0; m]);
         let mut land_row = vec![0.0; m + 1];
@@ -253,19 +238,6 @@ impl Continuation {
             // after chord steps at the iterate where Ω was kept: a predictor either way).
             let t_prev = t.clone();
             tangent(&mut tr.b, &mut t);
-            // A step that turned the tangent too far is taken again at half the length: turns
-            // are bracketed by steps the tangent follows (an S-curve's corner located to a few
-            // rpm, not the 60 rpm of one long step across it).
-            // A corner of the branch (the tangent turns as far at half the step) is accepted.
-            let angle = turned(&t_prev, &t);
-            let corner = rejected.is_some_and(|a| angle > 0.7 * a);
-            if angle > SHARP_ANGLE && !corner && step > 4.0 * self.min_step {
-                t.copy_from_slice(&t_prev);
-                step *= 0.5;
-                rejected = Some(angle);
-                continue;
-            }
-            rejected = None;
             let turn = t_prev[m] * t[m] < 0.0;
             let turn_omega = turn.then(|| {
                 let h = tr.distance(&x_new, o_new, &x, omega);
@@ -356,30 +328,13 @@ impl Continuation {
             if rejoined {
                 return Some(BranchStop::Rejoined { omega });
             }
-            step = self.next_step(step, iterations, &t_prev, &t);
+            if iterations <= 2 {
+                step = (step * 1.5).min(self.max_step);
+            } else if iterations >= 5 {
+                step *= 0.7;
+            }
         }
         None
-    }
-
-    /// The next step from the corrector's `iterations` and the angle between the last two
-    /// tangents: the branch's geometry. A step that turned the tangent by less than
-    /// [`FLAT_ANGLE`] grows even where the corrector needed several iterations (a stiff
-    /// contact opening or closing costs iterations, not curvature); one that turned it by
-    /// more than [`SHARP_ANGLE`] shrinks even where the corrector was quick.
-    fn next_step(&self, step: f64, iterations: usize, t_prev: &[f64], t: &[f64]) -> f64 {
-        let angle = turned(t_prev, t);
-        let grow = if angle < FLAT_ANGLE { 5 } else { 2 };
-        if angle > SHARP_ANGLE {
-            step * 0.7
-        } else if iterations <= grow {
-            // Nearly straight: double.
-            let factor = if angle < 0.25 * FLAT_ANGLE { 2.0 } else { 1.5 };
-            (step * factor).min(self.max_step)
-        } else if iterations >= 5 && angle >= FLAT_ANGLE {
-            step * 0.7
-        } else {
-            step
-        }
     }
 
     /// Appends the point `x` at `omega` (on the basis of `hb`); `Some(reason)` if its
