@@ -160,7 +160,8 @@ impl ExactSolution {
         self.waveform.time_series(points)
     }
 
-    /// The harmonics `0..points/2` of the closed form in time, harmonic-major (`Q[k n + i]`),
+    /// The harmonics `0..points/2` (of the forcing period; on a period-ν basis at `kν`) of the
+    /// closed form in time, harmonic-major (`Q[k n + i]`),
     /// from `points` samples of [`ExactSolution::time_series`] (rounded up to an even number,
     /// at least 4): with the ringing after each stiffness jump that the harmonics `0..=H` of
     /// [`ExactSolution::solution`] leave out, up to the aliasing of content above `points/2`.
@@ -169,19 +170,20 @@ impl ExactSolution {
         let points = points.max(4).next_multiple_of(2);
         let h = points / 2 - 1;
         let own = self.solution.basis();
-        let basis = HarmonicBasis::new(own.omega(), h)?
-            .with_samples(points)?
-            .with_subharmonic(own.subharmonic())?;
+        // The closed form's period is the forcing period: order j sits at harmonic jν of a
+        // period-ν basis.
+        let nu = own.subharmonic();
+        let basis = HarmonicBasis::new(own.omega(), h)?.with_samples(points)?;
         let plan = crate::harmonic::AftPlan::new(basis);
         let mut scratch = plan.make_scratch();
         let series = self.time_series(points);
         let n = series.len();
-        let mut out = vec![Complex64::default(); (h + 1) * n];
+        let mut out = vec![Complex64::default(); (h * nu + 1) * n];
         let mut one = vec![Complex64::default(); h + 1];
         for (i, mut x) in series.into_iter().enumerate() {
             plan.analyze_into(&mut x, &mut one, &mut scratch);
             for (k, c) in one.iter().enumerate() {
-                out[k * n + i] = *c;
+                out[k * nu * n + i] = *c;
             }
         }
         Ok(out)

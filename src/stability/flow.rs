@@ -265,6 +265,10 @@ impl<'c, 'm> Flow<'c, 'm> {
         let atol = std::mem::take(&mut self.atol);
         let result = self.period_with(y, opts, stepper, &bounds, &atol);
         self.atol = atol;
+        let period = std::f64::consts::TAU / self.omega;
+        if let Some(guide) = self.guide.as_mut() {
+            guide.offset += period;
+        }
         result
     }
 

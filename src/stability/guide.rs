@@ -24,6 +24,9 @@ pub(crate) struct Guide {
     /// The fundamental `ω = Ω/ν` in rad/s.
     fundamental: f64,
     n: usize,
+    /// The time of the flow's `t = 0` on the orbit: each forcing period restarts the flow's
+    /// clock, while the orbit of a period-`ν` solution goes on (`p · 2π/Ω` in period `p`).
+    pub(crate) offset: f64,
 }
 
 impl Guide {
@@ -43,6 +46,7 @@ impl Guide {
             acceleration,
             fundamental,
             n,
+            offset: 0.0,
         }
     }
 
@@ -50,7 +54,7 @@ impl Guide {
     /// `k ε`, 1e-14 at H = 128).
     pub(crate) fn acceleration_into(&self, t: f64, out: &mut [f64]) {
         out.fill(0.0);
-        let (s, c) = (self.fundamental * t).sin_cos();
+        let (s, c) = (self.fundamental * (t + self.offset)).sin_cos();
         let step = Complex64::new(c, s);
         let mut turn = step;
         for a in self.acceleration.chunks(self.n) {

@@ -120,7 +120,11 @@ impl FloquetOptions {
         cache: &mut FloquetCache,
         mut found: Floquet,
     ) -> Result<Floquet> {
-        let mut own = self.hb_orbit(sys, solution, cache)?;
+        // (a failure along the HB orbit leaves the exact orbit's multipliers standing)
+        let Ok(mut own) = self.hb_orbit(sys, solution, cache) else {
+            found.other_orbit = None;
+            return Ok(found);
+        };
         if !same_kind(&own, &found) {
             own.other_orbit = found.other_orbit;
             own.steps += found.steps;
