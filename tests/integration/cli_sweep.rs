@@ -438,17 +438,21 @@ fn sweep_raises_harmonics_along_the_branch() {
 fn progress_lines_where_stderr_is_not_a_terminal() {
     let scene =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/duffing.toml");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
-        .args([
-            "sweep",
-            scene.to_str().unwrap(),
-            "--to",
-            "2",
-            "--no-stability",
-        ])
-        .env("HBAL_PROGRESS_EVERY", "0")
-        .output()
-        .unwrap();
+    let sweep = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+            .args([
+                "sweep",
+                scene.to_str().unwrap(),
+                "--to",
+                "2",
+                "--no-stability",
+            ])
+            .args(extra)
+            .env("HBAL_PROGRESS_EVERY", "0")
+            .output()
+            .unwrap()
+    };
+    let out = sweep(&[]);
     assert_eq!(out.status.code(), Some(0));
     let err = String::from_utf8_lossy(&out.stderr);
     let lines: Vec<&str> = err
@@ -458,17 +462,6 @@ fn progress_lines_where_stderr_is_not_a_terminal() {
     assert!(lines.len() > 3, "{err}");
     assert!(lines.last().unwrap().contains("100 %"), "{err}");
     // With --json nothing but the document.
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
-        .args([
-            "sweep",
-            scene.to_str().unwrap(),
-            "--to",
-            "2",
-            "--no-stability",
-            "--json",
-        ])
-        .env("HBAL_PROGRESS_EVERY", "0")
-        .output()
-        .unwrap();
+    let out = sweep(&["--json"]);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("progress:"));
 }

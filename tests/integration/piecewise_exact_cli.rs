@@ -19,28 +19,21 @@ fn a_model_that_floats_free() {
     let (code, out, err) = run(&["compare", free, "--json"]);
     assert_eq!(code, Some(0), "{err}");
     let json: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let error_of = |name: &str| {
+    let field = |name: &str, pointer: &str| {
         json["methods"]
             .as_array()
             .unwrap()
             .iter()
             .find(|m| m["method"] == name)
-            .and_then(|m| m["error_vs_time_domain"].as_f64())
+            .and_then(|m| m.pointer(pointer).and_then(|v| v.as_f64()))
             .unwrap_or_else(|| panic!("{name} missing: {out}"))
     };
+    let error_of = |name: &str| field(name, "/error_vs_time_domain");
     assert!(error_of("piecewise_exact") < 1e-7, "{out}");
     assert!(error_of("newton") > 1e-5, "{out}");
     // Per quantity over the time series: the exact method by its closed form (its harmonics
     // 0..16 alone miss the ringing after each jump), harmonic balance by its harmonics.
-    let worst_of = |name: &str| {
-        json["methods"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|m| m["method"] == name)
-            .and_then(|m| m["worst_quantity_vs_time_domain"]["error"].as_f64())
-            .unwrap_or_else(|| panic!("{name} missing: {out}"))
-    };
+    let worst_of = |name: &str| field(name, "/worst_quantity_vs_time_domain/error");
     eprintln!(
         "worst quantity: exact {:.1e}, newton {:.1e}",
         worst_of("piecewise_exact"),
