@@ -378,6 +378,9 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 },
                 if matches!(scene.method, hbal::solve::Method::PiecewiseExact(_)) {
                     "what the exact solution lacks above H, and rounding".to_string()
+                } else if scene.model.is_linear_time_invariant() {
+                    "a linear time-invariant model is exact in H: rounding, by iterative refinement"
+                        .to_string()
                 } else {
                     format!(
                         "against 2H = {}, more where a jumping stiffness rings above it",

@@ -58,9 +58,12 @@ impl Continuation {
         basis: HarmonicBasis,
         to: f64,
         initial: Option<&[Complex64]>,
-        progress: impl FnMut(f64),
+        mut progress: impl FnMut(f64),
     ) -> Result<Branch> {
         crate::error::check_positive("continuation", "to", to)?;
+        if let Some(branch) = self.run_time_invariant(model, basis, to, &mut progress)? {
+            return Ok(branch);
+        }
         let from = basis.omega();
         let mut hb = HarmonicBalance::with_formulation(model, basis, self.formulation)?;
         crate::solve::check_dense_for_continuation(&hb)?;

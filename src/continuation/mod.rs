@@ -27,6 +27,7 @@ mod pipeline;
 mod point;
 mod speed_homotopy;
 mod switch;
+mod time_invariant;
 
 pub use parameter::{parameter_sweep, sweep_values};
 pub use point::TurnEvidence;

@@ -159,6 +159,16 @@ impl Model {
         self.elements.iter().find(|e| e.law().memory().is_some())
     }
 
+    /// `true` if every element is linear and time-invariant
+    /// ([`ForceLaw::is_linear_time_invariant`](crate::force::ForceLaw::is_linear_time_invariant)):
+    /// the model is `M q̈ + D0 q̇ + K0 q = f(t)`, whose harmonics decouple (one solve per
+    /// harmonic) and whose stability is that of its eigenvalues.
+    pub fn is_linear_time_invariant(&self) -> bool {
+        self.elements
+            .iter()
+            .all(|e| e.law().is_linear_time_invariant())
+    }
+
     /// `K0 = K + Σ_e k0_e w_e w_eᵀ`, the constant stiffness of the paper's split.
     pub fn k0(&self) -> SparseMatrix {
         self.stiffness.plus_outer(

@@ -177,7 +177,7 @@ pub fn estimate_error(model: &Model, solution: &Solution) -> Result<ErrorEstimat
 /// The estimate of `coarse` against `fine`: relative distances over `0..=2H` and `0..=H`,
 /// and per quantity, floored at 1e-15 (two solutions that agree to rounding do not make an
 /// error of zero).
-fn compare(model: &Model, coarse: &Solution, fine: &Solution) -> ErrorEstimate {
+pub(super) fn compare(model: &Model, coarse: &Solution, fine: &Solution) -> ErrorEstimate {
     let n = model.n_dofs();
     let (h, h2) = (coarse.basis().harmonics(), fine.basis().harmonics());
     let errors = quantity_errors(

@@ -21,6 +21,9 @@ mod quadrature;
 mod ringing;
 mod run;
 mod start;
+mod time_invariant;
+pub use time_invariant::solve_time_invariant;
+pub(crate) use time_invariant::{omega_slope, time_invariant_estimate, time_invariant_reference};
 
 pub(crate) use accuracy::refine;
 pub use accuracy::{

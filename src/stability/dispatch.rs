@@ -140,6 +140,9 @@ impl FloquetOptions {
                 got: format!("{} DOFs", solution.dof_names().len()),
             });
         }
+        if let Some(f) = super::time_invariant::floquet(model, solution, cache)? {
+            return Ok(f);
+        }
         let (sys, reduction) = match self.method.resolve(model) {
             FloquetMethod::Reduced => {
                 let (sys, info) = self.reduced_coordinates(model, solution, cache)?;
@@ -359,6 +362,8 @@ pub struct FloquetCache {
     /// The HB orbit's pieces did not apply (laws that are not piecewise affine): the next
     /// points go to the exact orbit directly.
     pub(super) exact_only: bool,
+    /// The state matrix's eigenvalues of a linear time-invariant model.
+    pub(super) time_invariant: Option<super::time_invariant::StateEigenvalues>,
 }
 
 /// Orbit corrections kept for the next point's prediction (a quadratic in Ω).

@@ -94,6 +94,7 @@ mod reduction;
 mod scales;
 mod shooting;
 mod system;
+mod time_invariant;
 
 use crate::error::Result;
 use crate::model::Model;

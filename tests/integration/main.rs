@@ -44,6 +44,7 @@ mod jenkins;
 mod jenkins_cli;
 mod kink_quadrature;
 mod linear;
+mod linear_sweep;
 mod matrix_import;
 mod matrix_import_bad_input;
 mod modes;
