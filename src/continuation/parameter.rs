@@ -59,6 +59,30 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
             parameter: p,
             reason,
         };
+        if matches!(cont.method, Method::PiecewiseExact(_)) {
+            // A linear time-invariant model: its exact solution is one solve per harmonic.
+            match super::time_invariant::exact_point(model, basis, p) {
+                Ok(Some(point)) => {
+                    let b = branch.get_or_insert_with(|| {
+                        Branch::new(model, basis, super::time_invariant::START.into())
+                    });
+                    if let Some(reason) = cont.push_point(b, model, point) {
+                        b.stop = BranchStop::StabilityFailed {
+                            omega: basis.omega(),
+                            reason,
+                        };
+                        break;
+                    }
+                    progress((i + 1) as f64 / values.len() as f64);
+                    continue;
+                }
+                Ok(None) => {}
+                Err(e) => {
+                    end_here(&mut branch, e, failed)?;
+                    break;
+                }
+            }
+        }
         let mut exact = None;
         let sol = if let Method::PiecewiseExact(method) = &cont.method {
             // No harmonic balance to build: every value is solved exactly.

@@ -28,7 +28,7 @@ use crate::{Formulation, HarmonicBasis};
 pub const MAX_TURN: f64 = 0.2;
 
 /// How the first point was found, for [`Branch::start`].
-const START: &str = "one solve per harmonic (linear time-invariant model)";
+pub(super) const START: &str = "one solve per harmonic (linear time-invariant model)";
 
 /// A solved point in the real layout with its scaled position.
 struct Sample {
@@ -165,6 +165,34 @@ impl Continuation {
                 reason,
             })
     }
+}
+
+/// The point of the linear time-invariant `model` on `basis` (swept parameter `parameter`)
+/// with its error estimate: what the exact piecewise method gives for such a model (its
+/// harmonics are exact, nothing lies above H), by one solve per harmonic. `None` where the
+/// shortcut does not apply.
+pub(super) fn exact_point(
+    model: &Model,
+    basis: HarmonicBasis,
+    parameter: f64,
+) -> Result<Option<NewPoint>> {
+    if !model.is_linear_time_invariant() || model.n_dofs() > Model::MAX_DENSE_DOFS {
+        return Ok(None);
+    }
+    let hb = HarmonicBalance::with_formulation(model, basis, Formulation::Full)?;
+    let Some(solution) = solve_time_invariant(&hb) else {
+        return Ok(None);
+    };
+    let mut point = NewPoint::new(
+        model,
+        basis,
+        solution.harmonics().to_vec(),
+        parameter,
+        solution.residual(),
+    )
+    .map_err(|reason| crate::Error::Solver { reason })?;
+    point.estimate = Some(time_invariant_estimate(&hb, &solution)?);
+    Ok(Some(point))
 }
 
 /// The solution at `omega` (`None` where the shortcut does not apply).

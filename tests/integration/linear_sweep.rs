@@ -233,3 +233,39 @@ fn the_cli_run_up_of_a_linear_line_reaches_its_end() {
         "{stdout}"
     );
 }
+
+/// The exact piecewise method's sweep of a linear time-invariant model: the same closed form,
+/// by one solve per harmonic (it integrated the state matrix's exponentials at every point:
+/// the 10-inertia line's 1000 points took 1.3 s, now 0.07 s).
+#[test]
+fn an_exact_method_sweep_of_a_linear_model_is_one_solve_per_harmonic() {
+    let (model, m, d, k) = chain();
+    let cont = Continuation {
+        method: hbal::solve::Method::PiecewiseExact(Default::default()),
+        ..Continuation::default()
+    };
+    let values: Vec<f64> = (0..50).map(|i| 0.5 + 0.4 * i as f64).collect();
+    let branch = hbal::continuation::sweep_values(
+        &values,
+        |w| Ok((&model, HarmonicBasis::new(w, 4)?)),
+        &cont,
+        |_| {},
+    )
+    .unwrap();
+    assert_eq!(branch.stop, BranchStop::Reached);
+    assert_eq!(branch.points.len(), 50);
+    assert!(
+        branch.start.contains("linear time-invariant"),
+        "{}",
+        branch.start
+    );
+    for p in &branch.points {
+        let exact = closed_form(&m, &d, &k, p.omega, 4);
+        let scale = exact.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        for (a, b) in p.harmonics.iter().zip(&exact) {
+            assert!((a - b).norm() <= 1e-12 * scale, "{a} vs {b} at {}", p.omega);
+        }
+        assert!(p.error_estimate.unwrap() < 1e-12);
+        assert_eq!(p.stable(), Some(true));
+    }
+}
