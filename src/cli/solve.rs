@@ -138,13 +138,19 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let extremes = exact.as_ref().map(|e| e.extremes());
     // Stability of a converged orbit (an unconverged iterate is no orbit to judge).
     let started = Instant::now();
-    // Laws with memory: no multipliers rather than wrong ones (not a failure of the solve).
-    let unavailable = scene.model.memory_element().map(|e| {
-        format!(
-            "stability not available for laws with memory (element `{}`)",
-            e.name()
-        )
-    });
+    // Laws with memory in a large model: no multipliers rather than wrong ones (not a failure
+    // of the solve); a small one is shot on the time-domain model.
+    let unavailable = scene
+        .model
+        .memory_element()
+        .filter(|_| scene.model.n_dofs() > hbal::stability::MAX_MEMORY_DOFS)
+        .map(|e| {
+            format!(
+                "stability not available for laws with memory (element `{}`) above {} DOFs",
+                e.name(),
+                hbal::stability::MAX_MEMORY_DOFS
+            )
+        });
     let stability: Option<Result<Floquet, String>> =
         (opts.stability && sol.is_converged() && unavailable.is_none()).then(|| {
             let floquet = match &exact {

@@ -164,7 +164,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     }
     if let Some(e) = scene.model.memory_element().filter(|_| opts.all_branches) {
         return Err(anyhow::anyhow!(
-            "--all-branches needs the stability of the points, which is not available for laws with memory (element `{}`)",
+            "--all-branches: branch switching is not available for laws with memory (element `{}`)",
             e.name()
         )
         .into());
@@ -339,10 +339,16 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 say!("  {hint}");
             }
         }
-        if let Some(e) = scene.model.memory_element().filter(|_| opts.stability) {
+        let large = scene.model.n_dofs() > hbal::stability::MAX_MEMORY_DOFS;
+        if let Some(e) = scene
+            .model
+            .memory_element()
+            .filter(|_| opts.stability && large)
+        {
             say!(
-                "  stability unknown: not available for laws with memory (element `{}`)",
-                e.name()
+                "  stability unknown: not available for laws with memory (element `{}`) above {} DOFs",
+                e.name(),
+                hbal::stability::MAX_MEMORY_DOFS
             );
         }
         if let Some(note) = out.and(super::dof_selection::note(&scene.model, &reported)) {

@@ -112,16 +112,15 @@ impl Continuation {
         None
     }
 
-    /// Whether `branch` of `model` is followed with a worker: stability on (and computable:
-    /// no law with memory), its last point's stability took at least
+    /// Whether `branch` of `model` is followed with a worker: stability on, its last point's
+    /// stability took at least
     /// [`Continuation::stability_worker`], and a second core.
-    pub(super) fn pipelined(&self, model: &Model, branch: &Branch) -> bool {
+    pub(super) fn pipelined(&self, _model: &Model, branch: &Branch) -> bool {
         let took = branch.stability_cache.last_time();
         self.stability.is_some()
             && self
                 .stability_worker
                 .is_some_and(|from| took.is_some_and(|t| t >= from))
-            && model.memory_element().is_none()
             && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
     }
 }

@@ -119,8 +119,13 @@ impl Continuation {
         let prev_stable = branch.points.last().and_then(|q| q.stable());
         let (floquet, failure) = match &self.stability {
             Some(_) if p.floquet.is_some() => (p.floquet, None),
-            // Laws with memory: stability unknown (see FloquetOptions::compute), the branch goes on.
-            Some(_) if model.memory_element().is_some() => (None, None),
+            // Laws with memory in a large model: stability unknown, the branch goes on.
+            Some(_)
+                if model.memory_element().is_some()
+                    && model.n_dofs() > crate::stability::MAX_MEMORY_DOFS =>
+            {
+                (None, None)
+            }
             Some(options) => {
                 // The modes and the last orbit correction carry over from point to point; the
                 // reduction's estimate is computed where a label is decided: at the first

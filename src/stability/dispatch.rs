@@ -125,12 +125,9 @@ impl FloquetOptions {
             ));
         }
         // The variational equation of a law with memory is not the one of `(∂f/∂u, ∂f/∂u̇)`:
-        // refuse rather than give wrong multipliers.
-        if let Some(e) = model.memory_element() {
-            return Err(Error::MemoryUnsupported {
-                analysis: "stability".into(),
-                element: e.name().to_string(),
-            });
+        // shooting on the time-domain model with the laws' states instead.
+        if model.memory_element().is_some() {
+            return super::memory_shooting::floquet(model, solution, self);
         }
         let n = model.n_dofs();
         if solution.harmonics().len() < n || solution.dof_names().len() != n {

@@ -80,6 +80,8 @@ mod integration;
 mod kept;
 mod kernels;
 mod kinks;
+mod memory_shooting;
+pub use memory_shooting::MAX_DOFS as MAX_MEMORY_DOFS;
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;

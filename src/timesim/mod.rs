@@ -17,6 +17,7 @@
 
 mod memory;
 mod period;
+mod period_map;
 mod rhs;
 mod scale;
 
@@ -30,6 +31,7 @@ use std::f64::consts::TAU;
 use std::time::{Duration, Instant};
 
 pub(crate) use period::segment_bounds;
+pub(crate) use period_map::PeriodMap;
 
 /// Options of the time-domain reference.
 #[derive(Debug, Clone, PartialEq)]
@@ -238,7 +240,7 @@ impl TimeSimulation {
         })
     }
 
-    fn validate(&self) -> Result<()> {
+    pub(crate) fn validate(&self) -> Result<()> {
         let ctx = "time simulation";
         if !(self.rtol.is_finite() && self.rtol > 0.0 && self.rtol < 1.0) {
             return Err(Error::invalid(ctx, "rtol", self.rtol, "in (0, 1)"));

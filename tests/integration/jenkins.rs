@@ -137,8 +137,8 @@ fn newton_converges_quadratically_on_the_jenkins_example() {
 
 /// NLvib's frequency response (H = 7, N = 1024, Ω from 0.5 to 2) traced to the end. The
 /// numbers are hbal's own (a regression check): its two confirmed folds at 1.5593 and 1.668;
-/// two further turns near 1.635 and 1.631 are classed as spurious, a classification that has no
-/// multipliers to rely on for laws with memory. Stability is unknown at every point.
+/// two further turns near 1.635 and 1.631 are classed as spurious. Every point has its
+/// multipliers (shooting on the time-domain model with the slider's state).
 #[test]
 fn frequency_response_over_nlvib_range() {
     let s = scene();
@@ -146,7 +146,7 @@ fn frequency_response_over_nlvib_range() {
         .run(&s.model, s.basis, 2.0, |_| {})
         .unwrap();
     assert_eq!(branch.stop, hbal::continuation::BranchStop::Reached);
-    assert!(branch.points.iter().all(|p| p.stable().is_none()));
+    assert!(branch.points.iter().all(|p| p.stable().is_some()));
     let mut folds: Vec<f64> = branch
         .points
         .iter()
@@ -231,7 +231,7 @@ fn clutch_damper_hysteresis_sweep_and_time_domain() {
         .run(&s.model, start, 3000.0 * per, |_| {})
         .unwrap();
     assert_eq!(branch.stop, hbal::continuation::BranchStop::Reached);
-    assert!(branch.points.iter().all(|p| p.stable().is_none()));
+    assert!(branch.points.iter().all(|p| p.stable().is_some()));
     eprintln!("clutch sweep: {} points", branch.points.len());
     let n = s.model.n_dofs();
     for rpm in [1000.0, 2000.0] {

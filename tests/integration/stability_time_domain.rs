@@ -45,15 +45,6 @@ fn stability_labels_agree_with_time_integration_for_every_scene() {
             let label = format!("{} at {factor} x speed ({})", file.display(), start.how);
             let sol = start.solution;
             assert!(sol.is_converged(), "{label}");
-            // Laws with memory: no multipliers (never wrong ones), a clear refusal instead.
-            if let Some(e) = model.memory_element() {
-                let err = sol.stability(model).unwrap_err().to_string();
-                assert!(
-                    err.contains("not available for laws with memory") && err.contains(e.name()),
-                    "{label}: {err}"
-                );
-                continue;
-            }
             let floquet = sol.stability(model).unwrap();
             let kick = 1e-3;
             let x0 = &floquet.orbit_start;
@@ -98,10 +89,12 @@ fn stability_labels_agree_with_time_integration_for_every_scene() {
             if !floquet.is_stable() {
                 eprintln!("unstable: {label}: max |μ| {}", floquet.max_abs());
             }
-            unstable_seen += usize::from(!floquet.is_stable());
+            // The clutch damper with friction hysteresis lies in its Neimark–Sacker window at
+            // its scene speed (1040 to 1300 rpm): unstable, as the time domain confirms above.
+            unstable_seen += usize::from(!floquet.is_stable() && model.memory_element().is_none());
         }
     }
-    // From their linear starts these orbits are stable but for one: the chain at its scene
+    // From their linear starts these orbits (laws without memory) are stable but for one: the chain at its scene
     // speed 1.36, past its branch point, where Newton keeps the symmetry of the linear start
     // and lands on the (unstable) symmetric orbit; time integration agrees. Unstable orbits
     // are checked against independent references in tests/integration/floquet_references.rs.
