@@ -391,12 +391,15 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             reduction: Some(r), ..
         })) = &stability
         {
-            let estimate = match r.estimate {
-                Some(e) => format!(
-                    ", multipliers to about {e:.1e} (against {} coordinates)",
-                    r.comparison_dofs.unwrap_or(0)
-                ),
-                None => String::new(),
+            let estimate = match (r.estimate, r.comparison_dofs) {
+                (Some(e), Some(wider)) => {
+                    format!(", multipliers to about {e:.1e} (against {wider} coordinates)")
+                }
+                // Every mode kept: a similarity transform of the full model, nothing to compare.
+                (Some(_), None) => {
+                    ", every mode kept: the model's own multipliers (no reduction)".to_string()
+                }
+                (None, _) => String::new(),
             };
             say!(
                 "  stability on a reduced basis: {} coordinates ({} modes below {:.0} rad/s, {} attachment modes){estimate}",

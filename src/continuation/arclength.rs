@@ -13,6 +13,16 @@ use crate::HarmonicBasis;
 use num_complex::Complex64;
 use std::sync::mpsc::sync_channel;
 
+/// A step that turned the tangent by less than this (rad) grows even where the corrector
+/// needed up to five iterations.
+const FLAT_ANGLE: f64 = 0.1;
+
+/// The angle (rad) between two unit tangents.
+fn turned(a: &[f64], b: &[f64]) -> f64 {
+    let cos: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    cos.clamp(-1.0, 1.0).acos()
+}
+
 /// Where a branch is followed: it lands exactly on `to` and stops there; with `back`, also on
 /// `back` should it leave the range that way (a secondary branch may head either way, and
 /// turn). A branch from a solve has no `back`: past a fold it may leave the range through its
@@ -331,7 +341,10 @@ impl Continuation {
             if rejoined {
                 return Some(BranchStop::Rejoined { omega });
             }
-            if iterations <= 2 {
+            // A stiff contact opening or closing costs corrector iterations, not curvature:
+            // where the tangent hardly turned, the step grows even after up to five.
+            let flat = iterations <= 5 && turned(&t_prev, &t) < FLAT_ANGLE;
+            if iterations <= 2 || flat {
                 step = (step * 1.5).min(self.max_step);
             } else if iterations >= 5 {
                 step *= 0.7;

@@ -32,12 +32,12 @@ fn duffing_one_harmonic_branch_is_the_analytic_curve() {
         let f2 = d.force * d.force;
         assert!((lhs - f2).abs() < 1e-8 * f2, "Ω {w}: {lhs} vs {f2}");
     }
-    // The upper fold sits near the backbone Ω² = 1 + ¾A² at the peak amplitude A ≈ F/(cΩ).
+    // The upper fold (interpolated) sits near the backbone Ω² = 1 + ¾A² at the peak amplitude A ≈ F/(cΩ).
     let upper = branch
         .points
         .iter()
         .filter(|p| p.fold)
-        .map(|p| p.omega)
+        .map(|p| p.fold_omega.unwrap())
         .fold(0.0, f64::max);
     let a_peak = branch
         .points
@@ -45,8 +45,11 @@ fn duffing_one_harmonic_branch_is_the_analytic_curve() {
         .map(|p| p.harmonics[1].norm())
         .fold(0.0, f64::max);
     let backbone = (1.0 + 0.75 * a_peak * a_peak).sqrt();
+    // (The fold interpolated from the tangents, 5e-5 from the backbone; the point after the
+    // turn lies up to a step further, 6e-3 where the step grows along the nearly straight
+    // approach.)
     assert!(
-        (upper - backbone).abs() < 2e-3,
+        (upper - backbone).abs() < 5e-4,
         "fold {upper} vs backbone {backbone}"
     );
 }
