@@ -143,10 +143,10 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let unavailable = scene
         .model
         .memory_element()
-        .filter(|_| scene.model.n_dofs() > hbal::stability::MAX_MEMORY_DOFS)
+        .filter(|_| !hbal::stability::memory_stability_available(&scene.model))
         .map(|e| {
             format!(
-                "stability not available for laws with memory (element `{}`) above {} DOFs",
+                "stability not available for laws with memory (element `{}`) in a free-free model or above {} DOFs",
                 e.name(),
                 hbal::stability::MAX_MEMORY_DOFS
             )

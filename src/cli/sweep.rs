@@ -339,14 +339,14 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
                 say!("  {hint}");
             }
         }
-        let large = scene.model.n_dofs() > hbal::stability::MAX_MEMORY_DOFS;
+        let unavailable = !hbal::stability::memory_stability_available(&scene.model);
         if let Some(e) = scene
             .model
             .memory_element()
-            .filter(|_| opts.stability && large)
+            .filter(|_| opts.stability && unavailable)
         {
             say!(
-                "  stability unknown: not available for laws with memory (element `{}`) above {} DOFs",
+                "  stability unknown: not available for laws with memory (element `{}`) in a free-free model or above {} DOFs",
                 e.name(),
                 hbal::stability::MAX_MEMORY_DOFS
             );

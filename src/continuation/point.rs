@@ -119,10 +119,11 @@ impl Continuation {
         let prev_stable = branch.points.last().and_then(|q| q.stable());
         let (floquet, failure) = match &self.stability {
             Some(_) if p.floquet.is_some() => (p.floquet, None),
-            // Laws with memory in a large model: stability unknown, the branch goes on.
+            // Laws with memory in a large or free-free model: stability unknown, the branch
+            // goes on.
             Some(_)
                 if model.memory_element().is_some()
-                    && model.n_dofs() > crate::stability::MAX_MEMORY_DOFS =>
+                    && !crate::stability::memory_stability_available(model) =>
             {
                 (None, None)
             }

@@ -75,6 +75,7 @@ impl Continuation {
             t
         };
         let direction = if to >= from { 1.0 } else { -1.0 };
+        let targets = resonances(model, from, to)?;
         let mut step = self.initial_step.min(self.max_step) * so;
         let mut last = first;
         if let Some(stop) = self.push_sample(&mut branch, model, &hb, &last) {
@@ -87,11 +88,18 @@ impl Continuation {
                 return Ok(Some(branch));
             }
             let next = loop {
-                let omega = if (to - last.omega).abs() <= step * 1.000001 {
+                let mut omega = if (to - last.omega).abs() <= step * 1.000001 {
                     to
                 } else {
                     last.omega + direction * step
                 };
+                // Never past a resonance without a point on it (a peak narrower than a step).
+                if let Some(&t) = targets
+                    .iter()
+                    .find(|&&t| (t - last.omega) * direction > 0.0 && (omega - t) * direction > 0.0)
+                {
+                    omega = t;
+                }
                 let next = match sample(&mut hb, &mut ws, omega) {
                     Ok(Some(s)) => s,
                     Ok(None) | Err(_) if step > self.min_step * so => {
@@ -179,7 +187,10 @@ pub(super) fn exact_point(
     if !model.is_linear_time_invariant() || model.n_dofs() > Model::MAX_DENSE_DOFS {
         return Ok(None);
     }
-    let hb = HarmonicBalance::with_formulation(model, basis, Formulation::Full)?;
+    // Not built (a load above H, which the exact method takes): the exact method decides.
+    let Ok(hb) = HarmonicBalance::with_formulation(model, basis, Formulation::Full) else {
+        return Ok(None);
+    };
     let Some(solution) = solve_time_invariant(&hb) else {
         return Ok(None);
     };
@@ -193,6 +204,40 @@ pub(super) fn exact_point(
     .map_err(|reason| crate::Error::Solver { reason })?;
     point.estimate = Some(time_invariant_estimate(&hb, &solution)?);
     Ok(Some(point))
+}
+
+/// The speeds in `(from, to)` (in the sweep's order) where a loaded order `k` meets a damped
+/// natural frequency `ω_d = Im λ` of the state matrix, `Ω = ω_d / k`, with the half-power
+/// points `Ω ± |Re λ| / k` beside it: every resonance gets points, however narrow.
+fn resonances(model: &Model, from: f64, to: f64) -> Result<Vec<f64>> {
+    let Some(lambdas) = crate::stability::state_eigenvalues(model)? else {
+        return Ok(Vec::new());
+    };
+    let mut orders: Vec<usize> = model
+        .loads()
+        .iter()
+        .filter(|l| l.order > 0 && (l.cos != 0.0 || l.sin != 0.0))
+        .map(|l| l.order)
+        .collect();
+    orders.sort_unstable();
+    orders.dedup();
+    let (lo, hi) = (from.min(to), from.max(to));
+    let mut out: Vec<f64> = lambdas
+        .iter()
+        .filter(|l| l.im > 0.0)
+        .flat_map(|l| {
+            orders.iter().flat_map(move |&k| {
+                let (w, width) = (l.im / k as f64, l.re.abs() / k as f64);
+                [w - width, w, w + width]
+            })
+        })
+        .filter(|w| *w > lo && *w < hi)
+        .collect();
+    out.sort_by(f64::total_cmp);
+    if to < from {
+        out.reverse();
+    }
+    Ok(out)
 }
 
 /// The solution at `omega` (`None` where the shortcut does not apply).

@@ -26,6 +26,11 @@ pub enum FloquetMethod {
     Dense,
     /// On the reduced basis (modes below the cut-off and attachment modes).
     Reduced,
+    /// The leading multipliers of the HB orbit (largest moduli) by the Arnoldi iteration on
+    /// the monodromy action, integrated in the model's own sparse matrices: no `2n × 2n`
+    /// matrix, for models with many modes in the excitation band (`sparse_action` module).
+    /// Diagonal mass matrices, no laws with memory, no free-free models.
+    Arnoldi,
 }
 
 impl FloquetMethod {
@@ -66,6 +71,11 @@ pub struct Reduction {
     /// Size of the comparison basis of the estimate.
     #[serde(default)]
     pub comparison_dofs: Option<usize>,
+    /// With [`FloquetMethod::Arnoldi`]: the Krylov vectors (monodromy actions) the leading
+    /// multipliers took; `estimate` is then the last change of the leading Ritz values
+    /// relative to the largest, and the basis is the model's own DOFs (`dofs`), nothing cut.
+    #[serde(default)]
+    pub krylov: Option<usize>,
 }
 
 /// Largest relative distance of the exact orbit's start from the HB state for which a shooting
@@ -139,6 +149,28 @@ impl FloquetOptions {
         }
         if let Some(f) = super::time_invariant::floquet(model, solution, cache)? {
             return Ok(f);
+        }
+        // Every mode in the band a reduced basis keeps (a long chain at speed): the leading
+        // multipliers by Arnoldi on the monodromy action instead of a dense 2n × 2n matrix.
+        let band =
+            self.cutoff * solution.basis().harmonics() as f64 * solution.basis().fundamental();
+        if self.method == FloquetMethod::Auto
+            && model.n_dofs() >= super::sparse_action::ARNOLDI_FROM
+            && super::sparse_action::every_mode_below(model, band)
+        {
+            if let Some(f) = super::sparse_action::floquet(model, solution)? {
+                return Ok(f);
+            }
+        }
+        if self.method == FloquetMethod::Arnoldi {
+            return super::sparse_action::floquet(model, solution)?.ok_or_else(|| {
+                Error::invalid(
+                    "floquet",
+                    "method",
+                    0.0,
+                    "`arnoldi` needs a diagonal mass matrix, no law with memory and no rigid-body mode",
+                )
+            });
         }
         let (sys, reduction) = match self.method.resolve(model) {
             FloquetMethod::Reduced => {
@@ -267,6 +299,7 @@ impl FloquetOptions {
             cutoff,
             estimate: None,
             comparison_dofs: None,
+            krylov: None,
         };
         Ok((
             Coordinates::reduced_with(model, basis.v, &basis.projected),

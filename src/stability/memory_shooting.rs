@@ -16,10 +16,9 @@
 //! the AFT does). A law that sticks over the whole period keeps a multiplier 1 (a family of
 //! orbits offset in the slider position); one that slips forgets its state (multiplier 0).
 //! The cost is `2(2n + s)` period integrations for the multipliers plus `2n + s + 1` per
-//! Newton step: small models only ([`MAX_DOFS`]).
+//! Newton step: small models only ([`MAX_DOFS`]), and grounded ones ([`available`]).
 
 use super::neutral::rigid_body_modes;
-use super::orbit_identity::other_orbit_threshold;
 use super::system::Coordinates;
 use super::{orbit_distance, Floquet, FloquetOptions, Orbit};
 use crate::error::{Error, Result};
@@ -57,12 +56,11 @@ pub(crate) fn floquet(
     solution: &Solution,
     options: &FloquetOptions,
 ) -> Result<Floquet> {
-    let n = model.n_dofs();
-    if n > MAX_DOFS {
+    if !available(model) {
         let element = model.memory_element().map_or("", |e| e.name());
         return Err(Error::MemoryUnsupported {
             analysis: format!(
-                "stability of a model over {MAX_DOFS} DOFs (finite differences on the time-domain model)"
+                "stability of a free-free model or one over {MAX_DOFS} DOFs (finite differences on the time-domain model)"
             ),
             element: element.to_string(),
         });
@@ -92,14 +90,21 @@ pub(crate) fn floquet(
         best = best.min(error);
         let (j, s) = jacobian(&map, &x, Some(&px), &scales)?;
         steps += s;
+        // Least squares: a slider that sticks all period leaves a zero row in J - I (its
+        // state is any), which the step leaves alone.
         let a = j - DMatrix::identity(x.len(), x.len());
-        let Some(delta) = a
-            .lu()
-            .solve(&DVector::from_iterator(r.len(), r.iter().map(|v| -v)))
-        else {
+        let rhs = DVector::from_iterator(r.len(), r.iter().map(|v| -v));
+        let Ok(delta) = a.svd(true, true).solve(&rhs, 1e-10) else {
             break;
         };
         x.iter_mut().zip(delta.iter()).for_each(|(x, d)| *x += d);
+    }
+    if !polished {
+        // The budget spent: polished if the map's noise is all that is left.
+        let (px, s) = map.apply(&x)?;
+        steps += s;
+        let r: Vec<f64> = px.iter().zip(&x).map(|(p, x)| p - x).collect();
+        polished = max_scaled(&r, &scales) < NOISE;
     }
     let (j, s) = jacobian(&map, &x, None, &scales)?;
     steps += s;
@@ -112,9 +117,6 @@ pub(crate) fn floquet(
             what: "a Floquet multiplier of the time-domain model with memory".into(),
         });
     }
-    let neutral = 2 * rigid_body_modes(&Coordinates::full(model)).ncols();
-    multipliers.sort_by(|a, b| (a - 1.0).norm().total_cmp(&(b - 1.0).norm()));
-    multipliers.drain(..neutral.min(multipliers.len()));
     multipliers.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
     let orbit_correction = max_scaled(
         &x.iter().zip(&hb).map(|(a, b)| a - b).collect::<Vec<_>>(),
@@ -123,7 +125,7 @@ pub(crate) fn floquet(
     let distance = orbit_distance(model, solution, &hb, &x[..hb.len()]);
     Ok(Floquet {
         multipliers,
-        neutral,
+        neutral: 0,
         orbit_correction,
         polished,
         orbit_start: x[..hb.len()].to_vec(),
@@ -132,8 +134,15 @@ pub(crate) fn floquet(
         orbit: Orbit::Exact,
         orbit_difference: None,
         orbit_distance: distance,
-        other_orbit: (distance > other_orbit_threshold(solution)).then_some(distance),
+        // The multipliers are those of the orbit found (no HB orbit's own to fall back on).
+        other_orbit: None,
     })
+}
+
+/// `true` if [`floquet`] applies to `model` (up to [`MAX_DOFS`] DOFs, no rigid-body mode:
+/// their neutral multipliers 1 are not set apart from a sticking slider's).
+pub fn available(model: &Model) -> bool {
+    model.n_dofs() <= MAX_DOFS && rigid_body_modes(&Coordinates::full(model)).ncols() == 0
 }
 
 /// `∂P/∂x` at `x` by forward differences from `P(x) = px`, or by central ones without it; and

@@ -66,6 +66,7 @@
 //! ```
 
 mod affine;
+mod arnoldi;
 mod chord;
 mod cubic;
 mod dispatch;
@@ -81,7 +82,7 @@ mod kept;
 mod kernels;
 mod kinks;
 mod memory_shooting;
-pub use memory_shooting::MAX_DOFS as MAX_MEMORY_DOFS;
+pub use memory_shooting::{available as memory_stability_available, MAX_DOFS as MAX_MEMORY_DOFS};
 mod modes;
 pub(crate) use modes::lowest_modes;
 mod neutral;
@@ -95,8 +96,10 @@ mod record;
 mod reduction;
 mod scales;
 mod shooting;
+mod sparse_action;
 mod system;
 mod time_invariant;
+pub(crate) use time_invariant::eigenvalues as state_eigenvalues;
 
 use crate::error::Result;
 use crate::model::Model;

@@ -119,3 +119,51 @@ fn the_estimate_of_the_cut_off_basis_is_truthful() {
     assert_eq!(dense.is_stable(), reduced.is_stable());
     assert!((dense.max_abs() - reduced.max_abs()).abs() <= error + 1e-12);
 }
+
+/// The Arnoldi iteration on the monodromy action (issue 31, item 4) against the dense
+/// monodromy matrix of the same HB orbit on small models: the leading multipliers (modulus at
+/// least a tenth of the largest) agree. Grounded models with a diagonal mass matrix.
+#[test]
+fn arnoldi_gives_the_leading_dense_multipliers() {
+    use hbal::stability::Orbit;
+    let two_shaft = scene("examples/scenes/two_shaft_6000rpm.toml");
+    let chain = scene("tests/data/floquet/chain_backlash.toml");
+    let (drive, drive_solution) = drivetrain(12, 2000.0);
+    let mut cases: Vec<(&str, Model, Solution)> = Vec::new();
+    for (label, s) in [("two-shaft", two_shaft), ("backlash chain", chain)] {
+        let solution = solve(&s.model, s.basis, Formulation::Full);
+        cases.push((label, s.model, solution));
+    }
+    cases.push(("drivetrain n = 12", drive, drive_solution));
+    for (label, model, solution) in &cases {
+        let options = FloquetOptions {
+            orbit: Orbit::Harmonic,
+            ..FloquetOptions::default()
+        };
+        let dense = options
+            .with_method(FloquetMethod::Dense)
+            .compute(model, solution)
+            .unwrap();
+        let arnoldi = options
+            .with_method(FloquetMethod::Arnoldi)
+            .compute(model, solution)
+            .unwrap();
+        let top = dense.max_abs();
+        let leading = |m: &[Complex64]| -> Vec<Complex64> {
+            m.iter()
+                .copied()
+                .filter(|v| v.norm() >= 0.1 * top)
+                .collect()
+        };
+        let (a, d) = (leading(&arnoldi.multipliers), leading(&dense.multipliers));
+        let distance = hausdorff(&a, &d);
+        eprintln!(
+            "{label}: max |μ| dense {top:.6}, arnoldi {:.6}, {} leading, distance {distance:.1e}, {} vectors",
+            arnoldi.max_abs(),
+            d.len(),
+            arnoldi.reduction.as_ref().unwrap().krylov.unwrap()
+        );
+        assert!(distance < 1e-4 * top.max(1.0), "{label}: {a:?} vs {d:?}");
+        assert_eq!(arnoldi.is_stable(), dense.is_stable(), "{label}");
+    }
+}
