@@ -139,7 +139,7 @@ pub(crate) fn floquet(
     })
 }
 
-/// `true` if [`floquet`] applies to `model` (up to [`MAX_DOFS`] DOFs, no rigid-body mode:
+/// `true` if the shooting of laws with memory applies to `model` (up to [`MAX_DOFS`] DOFs, no rigid-body mode:
 /// their neutral multipliers 1 are not set apart from a sticking slider's).
 pub fn available(model: &Model) -> bool {
     model.n_dofs() <= MAX_DOFS && rigid_body_modes(&Coordinates::full(model)).ncols() == 0
