@@ -147,14 +147,7 @@ impl Continuation {
         hb: &HarmonicBalance,
         s: &Sample,
     ) -> Option<BranchStop> {
-        let basis = *s.solution.basis();
-        let point = match NewPoint::new(
-            model,
-            basis,
-            s.solution.harmonics().to_vec(),
-            s.omega,
-            s.solution.residual(),
-        ) {
+        let mut point = match point_of(model, &s.solution, s.omega) {
             Ok(p) => p,
             Err(reason) => {
                 return Some(BranchStop::Failed {
@@ -163,7 +156,6 @@ impl Continuation {
                 })
             }
         };
-        let mut point = point;
         if self.error_estimate {
             point.estimate = time_invariant_estimate(hb, &s.solution).ok();
         }
@@ -194,14 +186,8 @@ pub(super) fn exact_point(
     let Some(solution) = solve_time_invariant(&hb) else {
         return Ok(None);
     };
-    let mut point = NewPoint::new(
-        model,
-        basis,
-        solution.harmonics().to_vec(),
-        parameter,
-        solution.residual(),
-    )
-    .map_err(|reason| crate::Error::Solver { reason })?;
+    let mut point =
+        point_of(model, &solution, parameter).map_err(|reason| crate::Error::Solver { reason })?;
     point.estimate = Some(time_invariant_estimate(&hb, &solution)?);
     Ok(Some(point))
 }
@@ -238,6 +224,21 @@ fn resonances(model: &Model, from: f64, to: f64) -> Result<Vec<f64>> {
         out.reverse();
     }
     Ok(out)
+}
+
+/// The branch point of `solution` (swept parameter `parameter`).
+fn point_of(
+    model: &Model,
+    solution: &crate::Solution,
+    parameter: f64,
+) -> std::result::Result<NewPoint, String> {
+    NewPoint::new(
+        model,
+        *solution.basis(),
+        solution.harmonics().to_vec(),
+        parameter,
+        solution.residual(),
+    )
 }
 
 /// The solution at `omega` (`None` where the shortcut does not apply).

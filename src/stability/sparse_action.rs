@@ -49,18 +49,9 @@ impl VariationalAction {
             return Ok(None);
         }
         let n = model.n_dofs();
-        let mut inv_mass = vec![0.0; n];
-        for (i, j, v) in model.mass().iter() {
-            if i != j && v != 0.0 {
-                return Ok(None);
-            }
-            if i == j {
-                inv_mass[i] = 1.0 / v;
-            }
-        }
-        if inv_mass.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        let Some(inv_mass) = inverse_diagonal_mass(model) else {
             return Ok(None);
-        }
+        };
         let elements: Vec<&crate::model::Element> = model
             .elements()
             .iter()
@@ -105,11 +96,7 @@ impl VariationalAction {
         // The fastest motion: Gershgorin on M⁻¹(K0 + Σ max(Δk, 0) w wᵀ), sampled coarsely.
         let coarse: Vec<Vec<(f64, f64)>> =
             (0..256).map(|j| at(period * j as f64 / 256.0)).collect();
-        let mut rows = vec![0.0; n];
-        for (i, j, v) in k0.iter() {
-            let _ = j;
-            rows[i] += v.abs();
-        }
+        let mut rows = absolute_row_sums(&k0);
         for (e, element) in elements.iter().enumerate() {
             let top = coarse.iter().map(|s| s[e].0).fold(0.0, f64::max);
             let sum: f64 = element.weights().iter().map(|(_, w)| w.abs()).sum();
@@ -392,24 +379,36 @@ pub const ARNOLDI_FROM: usize = 256;
 /// `true` if every natural frequency of `(K0, M)` lies below `cutoff` (rad/s) by Gershgorin's
 /// bound `ω² ≤ max_i Σ_j |K0_ij| / M_ii` (a diagonal mass matrix; `false` otherwise).
 pub(crate) fn every_mode_below(model: &Model, cutoff: f64) -> bool {
-    let n = model.n_dofs();
-    let mut mass = vec![0.0; n];
-    for (i, j, v) in model.mass().iter() {
-        if i != j && v != 0.0 {
-            return false;
-        }
-        if i == j {
-            mass[i] = v;
-        }
-    }
-    let mut rows = vec![0.0; n];
-    for (i, _, v) in model.k0().iter() {
-        rows[i] += v.abs();
-    }
-    let bound = rows
+    let Some(inv_mass) = inverse_diagonal_mass(model) else {
+        return false;
+    };
+    let bound = absolute_row_sums(&model.k0())
         .iter()
-        .zip(&mass)
-        .map(|(r, m)| if *m > 0.0 { r / m } else { f64::INFINITY })
+        .zip(&inv_mass)
+        .map(|(r, m)| r * m)
         .fold(0.0, f64::max);
     bound <= cutoff * cutoff
+}
+
+/// `1 / M_ii` of a diagonal, positive mass matrix; `None` otherwise.
+fn inverse_diagonal_mass(model: &Model) -> Option<Vec<f64>> {
+    let mut inv = vec![0.0; model.n_dofs()];
+    for (i, j, v) in model.mass().iter() {
+        if i != j && v != 0.0 {
+            return None;
+        }
+        if i == j {
+            inv[i] = 1.0 / v;
+        }
+    }
+    inv.iter().all(|v| v.is_finite() && *v > 0.0).then_some(inv)
+}
+
+/// `Σ_j |A_ij|` per row.
+fn absolute_row_sums(a: &SparseMatrix) -> Vec<f64> {
+    let mut rows = vec![0.0; a.n()];
+    for (i, _, v) in a.iter() {
+        rows[i] += v.abs();
+    }
+    rows
 }
