@@ -3,8 +3,9 @@
 //! solved, then its leading Floquet multipliers by the Arnoldi iteration on the monodromy
 //! action (what `FloquetMethod::Auto` picks there). Prints the times and the multipliers.
 //!
-//! `cargo run --release --example mesh_chain_stability [-- DOFS]`; `/usr/bin/time -v` gives
-//! the whole process's memory.
+//! `cargo run --release --example mesh_chain_stability [-- DOFS [SCENE.toml]]`;
+//! `/usr/bin/time -v` gives the whole process's memory. With a scene path the chain is also
+//! written as a scene (matrices in a directory next to it) for `hbal solve`.
 
 use hbal::catalog::MeshChain;
 use hbal::stability::FloquetOptions;
@@ -21,6 +22,16 @@ fn main() -> hbal::Result<()> {
         ..MeshChain::default()
     }
     .model()?;
+    if let Some(path) = std::env::args().nth(2) {
+        let settings = hbal::scene::export::SceneSettings::new(
+            &format!("Mesh chain (hbal::catalog::MeshChain), {dofs} DOFs, 4 backlash meshes"),
+            "rad_s",
+            120.0,
+            32,
+        );
+        hbal::scene::export::write_scene(&model, &settings, std::path::Path::new(&path))
+            .map_err(|e| hbal::Error::invalid("scene", "path", f64::NAN, e.to_string()))?;
+    }
     let basis = HarmonicBasis::new(120.0, 32)?;
     let started = Instant::now();
     let hb = HarmonicBalance::with_formulation(&model, basis, Formulation::Condensed)?;
@@ -37,7 +48,7 @@ fn main() -> hbal::Result<()> {
     let stability = started.elapsed();
     let r = floquet.reduction.as_ref();
     println!(
-        "stability {:.2} s: {} (max |μ| = {:.6}), {} Krylov vectors, {} Runge–Kutta steps, Ritz change {:.1e}",
+        "stability {:.2} s: {} (max |μ| = {:.6}), {} Krylov vectors, {} Runge–Kutta steps, multipliers to about {:.1e}",
         stability.as_secs_f64(),
         if floquet.is_stable() { "stable" } else { "unstable" },
         floquet.max_abs(),

@@ -376,6 +376,9 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 f.neutral,
                 f.orbit_correction,
                 match (f.polished, f.orbit_distance > hbal::stability::OTHER_ORBIT_DISTANCE) {
+                    (false, _) if f.reduction.as_ref().is_some_and(|r| r.krylov.is_some()) => {
+                        " (multipliers along the HB orbit)".to_string()
+                    }
                     (false, _) => " (shooting did not converge: multipliers along the HB orbit)".to_string(),
                     (true, true) => format!(
                         " (the exact orbit starts {:.1e} of the dynamic range from the HB orbit: the HB solution is that far off, or the shooting found a neighbouring orbit of the same kind)",
@@ -391,6 +394,13 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
             reduction: Some(r), ..
         })) = &stability
         {
+            if let Some(actions) = r.krylov {
+                say!(
+                    "  stability by the Arnoldi iteration on the monodromy action: {actions} actions on all {} DOFs (no 2n × 2n matrix), leading multipliers to about {:.1e} (Krylov and integration parts)",
+                    r.dofs,
+                    r.estimate.unwrap_or(f64::NAN)
+                );
+            }
             let estimate = match (r.estimate, r.comparison_dofs) {
                 (Some(e), Some(wider)) => {
                     format!(", multipliers to about {e:.1e} (against {wider} coordinates)")
@@ -401,13 +411,15 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
                 }
                 (None, _) => String::new(),
             };
-            say!(
-                "  stability on a reduced basis: {} coordinates ({} modes below {:.0} rad/s, {} attachment modes){estimate}",
-                r.dofs,
-                r.modes,
-                r.cutoff,
-                r.attachment
-            );
+            if r.krylov.is_none() {
+                say!(
+                    "  stability on a reduced basis: {} coordinates ({} modes below {:.0} rad/s, {} attachment modes){estimate}",
+                    r.dofs,
+                    r.modes,
+                    r.cutoff,
+                    r.attachment
+                );
+            }
         }
     }
     match &stability {

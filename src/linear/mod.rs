@@ -4,7 +4,7 @@
 
 pub mod condensation;
 pub mod envelope;
-mod parallel;
+pub(crate) mod parallel;
 mod sparse_factor;
 pub mod sparse_pattern;
 pub mod sparse_stiffness;

@@ -27,6 +27,16 @@ pub(crate) fn threads(work: usize) -> usize {
     cores.min(asked).max(1)
 }
 
+/// Threads for a few long, independent tasks (tens of milliseconds each, where a busy core
+/// costs little against the spawn): `HBAL_THREADS` if set, otherwise every available core.
+pub(crate) fn threads_for_long_tasks() -> usize {
+    std::env::var("HBAL_THREADS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .filter(|&t| t >= 1)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
 /// `[f(0, items[0]), f(1, items[1]), …]` on up to `threads` threads: each call owns its item
 /// (a buffer of the last speed's, to be filled again instead of allocated).
 pub(crate) fn map_owned<B: Send, T: Send>(

@@ -3,13 +3,15 @@
 //!
 //! From a unit start vector `v_1`, `w = Φ v_j` is orthogonalised against `v_1 … v_j` (classical
 //! Gram–Schmidt, twice), `h_ij = v_iᵀ w`, `h_{j+1,j} = ‖w‖`, `v_{j+1} = w / h_{j+1,j}`, so that
-//! `Φ V_j = V_j H_j + h_{j+1,j} v_{j+1} e_jᵀ` with `H_j` upper Hessenberg. The eigenvalues of
-//! `H_j` (Ritz values) converge to the outermost eigenvalues of `Φ` first; for a monodromy
-//! matrix those are the multipliers that decide stability, while the many strongly damped
-//! modes crowd near 0. The iteration stops when the leading Ritz values (modulus at least a
-//! tenth of the largest, at most [`LEADING`]) agree to the tolerance between two checks
-//! [`CHECK_EVERY`] vectors apart, when `h_{j+1,j}` vanishes (an invariant subspace: exact), or
-//! at the vector limit.
+//! `Φ V_j = V_{j+1} H_{j+1,j}` with `H` upper Hessenberg. The eigenvalues of the square `H_j`
+//! (Ritz values) converge to the outermost eigenvalues of `Φ` first; for a monodromy matrix
+//! those are the multipliers that decide stability, while the many strongly damped modes crowd
+//! near 0. The iteration stops when the leading Ritz values (modulus at least a tenth of the
+//! largest, at most [`LEADING`]) agree to the tolerance between two checks [`CHECK_EVERY`]
+//! vectors apart, when `h_{j+1,j}` vanishes (an invariant subspace: exact), or at the vector
+//! limit. (A block of two start vectors, whose two actions per step could run side by side,
+//! needed twice the vectors on the 1000-DOF chain's cluster of multipliers: the polynomial
+//! degree, not the dimension, is what resolves a cluster.)
 
 use crate::error::Result;
 use nalgebra::DMatrix;
@@ -31,6 +33,10 @@ pub(crate) struct Ritz {
     /// The largest change of the leading Ritz values between the last two checks (0 for an
     /// invariant subspace).
     pub(crate) change: f64,
+    /// The unit Ritz vector `y = V_k s` of `values[0]`, real and imaginary parts.
+    pub(crate) leading_vector: (Vec<f64>, Vec<f64>),
+    /// Its image `Φ y = V_{k+b} H s` by the Arnoldi relation (no further action).
+    pub(crate) leading_image: (Vec<f64>, Vec<f64>),
 }
 
 /// The leading eigenvalues of the operator `apply` (`out = Φ x`, dimension `dim`) from the
@@ -50,45 +56,101 @@ pub(crate) fn leading_eigenvalues(
     let mut h = DMatrix::<f64>::zeros(m + 1, m);
     let mut w = vec![0.0; dim];
     let mut previous: Option<Vec<Complex64>> = None;
-    let mut last = Ritz {
-        values: Vec::new(),
-        vectors: 0,
-        change: f64::INFINITY,
-    };
+    let (mut values, mut change, mut done) = (Vec::new(), f64::INFINITY, 0);
     for j in 0..m {
         apply(&basis[j], &mut w)?;
-        for _ in 0..2 {
-            for (i, v) in basis.iter().enumerate() {
-                let c: f64 = v.iter().zip(&w).map(|(a, b)| a * b).sum();
-                h[(i, j)] += c;
-                w.iter_mut().zip(v).for_each(|(w, v)| *w -= c * v);
-            }
-        }
+        let mut column = vec![0.0; j + 1];
+        orthogonalise(&basis, &mut w, &mut column);
         let beta = norm(&w);
+        for (i, c) in column.iter().enumerate() {
+            h[(i, j)] = *c;
+        }
         h[(j + 1, j)] = beta;
-        let scale = (0..=j).map(|i| h[(i, j)].abs()).fold(beta, f64::max);
+        done = j + 1;
+        let scale = column.iter().fold(beta, |a, c| a.max(c.abs()));
         let invariant = beta <= 1e-14 * scale.max(f64::MIN_POSITIVE);
-        if invariant || (j + 1) % CHECK_EVERY == 0 || j + 1 == m {
-            let values = ritz_values(&h, j + 1);
-            let change = match &previous {
+        if invariant || done % CHECK_EVERY == 0 || done == m {
+            values = ritz_values(&h, done);
+            change = match &previous {
                 _ if invariant => 0.0,
                 Some(p) => distance(&values, p),
                 None => f64::INFINITY,
             };
             let top = values.first().map_or(0.0, |v| v.norm());
-            last = Ritz {
-                values: values.clone(),
-                vectors: j + 1,
-                change,
-            };
             if invariant || change <= tol * top.max(f64::MIN_POSITIVE) {
-                return Ok(last);
+                break;
             }
-            previous = Some(values);
+            previous = Some(values.clone());
         }
         basis.push(w.iter().map(|v| v / beta).collect());
     }
-    Ok(last)
+    let (leading_vector, leading_image) = ritz_vector(&h, done, &basis, values.first().copied());
+    Ok(Ritz {
+        values,
+        vectors: done,
+        change,
+        leading_vector,
+        leading_image,
+    })
+}
+
+/// `w ← w − Σ v_i (v_iᵀ w)` over `basis`, twice; the coefficients added to `column`.
+fn orthogonalise(basis: &[Vec<f64>], w: &mut [f64], column: &mut [f64]) {
+    for _ in 0..2 {
+        for (i, v) in basis.iter().enumerate() {
+            let c: f64 = v.iter().zip(w.iter()).map(|(a, b)| a * b).sum();
+            column[i] += c;
+            w.iter_mut().zip(v).for_each(|(w, v)| *w -= c * v);
+        }
+    }
+}
+
+/// Real and imaginary parts of a complex vector.
+type Pair = (Vec<f64>, Vec<f64>);
+
+/// The unit vector `y = V_k s` and its image `Φ y = V H s`, `s` the eigenvector of `H_k` for
+/// `theta` by two steps of inverse iteration (zero vectors if there is no value).
+fn ritz_vector(
+    h: &DMatrix<f64>,
+    k: usize,
+    basis: &[Vec<f64>],
+    theta: Option<Complex64>,
+) -> (Pair, Pair) {
+    let dim = basis.first().map_or(0, Vec::len);
+    let zero = || (vec![0.0; dim], vec![0.0; dim]);
+    let Some(theta) = theta.filter(|_| k > 0) else {
+        return (zero(), zero());
+    };
+    let shift = theta + Complex64::new(1e-10, 1e-10) * theta.norm().max(1e-300);
+    let a = DMatrix::<Complex64>::from_fn(k, k, |i, j| {
+        Complex64::from(h[(i, j)]) - if i == j { shift } else { 0.0.into() }
+    });
+    let lu = a.lu();
+    let mut s = nalgebra::DVector::<Complex64>::from_element(k, Complex64::from(1.0));
+    for _ in 0..2 {
+        s = lu.solve(&s).unwrap_or(s);
+        let n = s.norm();
+        if n.is_finite() && n > 0.0 {
+            s /= Complex64::from(n);
+        }
+    }
+    let rows = basis.len().min(h.nrows());
+    let hs: Vec<Complex64> = (0..rows)
+        .map(|i| (0..k).map(|j| s[j] * h[(i, j)]).sum())
+        .collect();
+    let combine = |c: &[Complex64]| -> Pair {
+        let (mut re, mut im) = zero();
+        for (c, v) in c.iter().zip(basis) {
+            for ((r, i), x) in re.iter_mut().zip(im.iter_mut()).zip(v) {
+                *r += c.re * x;
+                *i += c.im * x;
+            }
+        }
+        (re, im)
+    };
+    let (y, image) = (combine(s.as_slice()), combine(&hs));
+    // y is a unit vector already (V orthonormal, ‖s‖ = 1).
+    (y, image)
 }
 
 /// The eigenvalues of the leading `k × k` block of `h`, largest modulus first.
@@ -138,10 +200,11 @@ mod tests {
             a[(2 * k + 1, 2 * k + 1)] = c;
         }
         let start: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
+        let a = &a;
         let ritz = leading_eigenvalues(
             n,
             |x, out| {
-                out.copy_from_slice((&a * nalgebra::DVector::from_column_slice(x)).as_slice());
+                out.copy_from_slice((a * nalgebra::DVector::from_column_slice(x)).as_slice());
                 Ok(())
             },
             &start,
@@ -158,6 +221,18 @@ mod tests {
             (ritz.values[2].norm() - 0.84).abs() < 1e-8,
             "{:?}",
             &ritz.values[..4]
+        );
+        // The Ritz vector is the eigenvector: ‖A y − θ y‖ small for the unit y.
+        let (re, im) = &ritz.leading_vector;
+        let y = nalgebra::DVector::from_iterator(
+            n,
+            re.iter().zip(im).map(|(r, i)| Complex64::new(*r, *i)),
+        );
+        let ay = a.map(Complex64::from) * &y;
+        let residual = (ay - &y * got).norm();
+        assert!(
+            (y.norm() - 1.0).abs() < 1e-12 && residual < 1e-8,
+            "{residual}"
         );
     }
 }

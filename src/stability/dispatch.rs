@@ -28,7 +28,7 @@ pub enum FloquetMethod {
     Reduced,
     /// The leading multipliers of the HB orbit (largest moduli) by the Arnoldi iteration on
     /// the monodromy action, integrated in the model's own sparse matrices: no `2n × 2n`
-    /// matrix, for models with many modes in the excitation band (`sparse_action` module).
+    /// matrix, for models with many modes in the excitation band (`krylov_floquet` module).
     /// Diagonal mass matrices, no laws with memory, no free-free models.
     Arnoldi,
 }
@@ -72,8 +72,11 @@ pub struct Reduction {
     #[serde(default)]
     pub comparison_dofs: Option<usize>,
     /// With [`FloquetMethod::Arnoldi`]: the Krylov vectors (monodromy actions) the leading
-    /// multipliers took; `estimate` is then the last change of the leading Ritz values
-    /// relative to the largest, and the basis is the model's own DOFs (`dofs`), nothing cut.
+    /// multipliers took; `estimate` is then, relative to the largest modulus, the larger of
+    /// the last change of the leading Ritz values (the Krylov part) and the integration part,
+    /// `‖(Φ_{h/2} − Φ_h) y‖` for the leading Ritz vector `y` (the Runge–Kutta steps are
+    /// refined until it is below 1e-6); the basis is the model's own DOFs (`dofs`), nothing
+    /// cut.
     #[serde(default)]
     pub krylov: Option<usize>,
 }
@@ -155,15 +158,15 @@ impl FloquetOptions {
         let band =
             self.cutoff * solution.basis().harmonics() as f64 * solution.basis().fundamental();
         if self.method == FloquetMethod::Auto
-            && model.n_dofs() >= super::sparse_action::ARNOLDI_FROM
-            && super::sparse_action::every_mode_below(model, band)
+            && model.n_dofs() >= super::krylov_floquet::ARNOLDI_FROM
+            && super::krylov_floquet::every_mode_below(model, band)
         {
-            if let Some(f) = super::sparse_action::floquet(model, solution)? {
+            if let Some(f) = super::krylov_floquet::floquet(model, solution)? {
                 return Ok(f);
             }
         }
         if self.method == FloquetMethod::Arnoldi {
-            return super::sparse_action::floquet(model, solution)?.ok_or_else(|| {
+            return super::krylov_floquet::floquet(model, solution)?.ok_or_else(|| {
                 Error::invalid(
                     "floquet",
                     "method",

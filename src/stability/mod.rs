@@ -89,6 +89,8 @@ mod neutral;
 mod orbit_check;
 mod orbit_identity;
 pub use orbit_identity::{orbit_distance, OTHER_ORBIT_DISTANCE};
+mod krylov_floquet;
+mod linear_rate;
 mod pieces;
 mod pipeline;
 mod propagator;
