@@ -43,6 +43,14 @@ pub enum Error {
         /// What is wrong, naming the fields.
         reason: String,
     },
+    /// Options of an analysis that contradict each other or the scene.
+    #[error("{option} {reason}")]
+    InvalidOptions {
+        /// The option, e.g. `--start`.
+        option: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// Two DOFs share a name, or there are none.
     #[error("invalid DOF list: {reason}")]
     InvalidDofs {

@@ -52,6 +52,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod catalog;
 pub mod compare;
 pub mod continuation;

@@ -1,47 +1,12 @@
-//! Element outputs of `hbal solve` ([`hbal::report::element_outputs`]) as text lines, JSON
-//! and `elements.csv`; every harmonic is named by its index k (`harmonic`) and by the order it
-//! is of the scene's reference speed (`shaft_order`; the DOFs' `order` is the index k).
+//! Element outputs of `hbal solve` ([`hbal::report::element_outputs`]) as text lines and
+//! `elements.csv` (their JSON form is the library's, `hbal::analysis`); every harmonic is
+//! named by its index k (`harmonic`) and by the order it is of the scene's reference speed
+//! (`shaft_order`; the DOFs' `order` is the index k).
 
-use hbal::report::{ElementOutput, Signal};
-use serde_json::{json, Value};
+use hbal::report::ElementOutput;
 use std::path::Path;
 
-/// The order of harmonic `k` relative to the reference speed: `k · order / ν`.
-pub(crate) fn order_of(k: usize, fundamental_order: f64, subharmonic: usize) -> f64 {
-    k as f64 * fundamental_order / subharmonic.max(1) as f64
-}
-
-fn signal_json(s: &Signal, order: impl Fn(usize) -> f64) -> Value {
-    json!({
-        "mean": s.mean(),
-        "min": s.min,
-        "max": s.max,
-        "peak_to_peak": s.peak_to_peak(),
-        "harmonics": s.harmonics.iter().enumerate().map(|(k, x)| {
-            let (c, sn) = hbal::harmonic::cos_sin(*x);
-            json!({"harmonic": k, "shaft_order": order(k), "cos": c, "sin": sn})
-        }).collect::<Vec<_>>(),
-    })
-}
-
-/// The `elements` array of the JSON output.
-pub(crate) fn json(outputs: &[ElementOutput], order: impl Fn(usize) -> f64 + Copy) -> Value {
-    Value::Array(
-        outputs
-            .iter()
-            .map(|e| {
-                json!({
-                    "name": e.name,
-                    "type": e.kind,
-                    "coordinate": signal_json(&e.coordinate, order),
-                    "force": signal_json(&e.force, order),
-                    "states": e.states.iter().map(|(n, f)| json!({"state": n, "fraction": f})).collect::<Vec<_>>(),
-                    "gear_stage": e.mesh,
-                })
-            })
-            .collect(),
-    )
-}
+pub(crate) use hbal::analysis::order_of;
 
 /// One line per element for the text output.
 pub(crate) fn lines(outputs: &[ElementOutput]) -> Vec<String> {

@@ -36,7 +36,7 @@ pub(crate) mod report_html;
 pub(crate) mod solve;
 pub(crate) mod solve_exact;
 mod solve_files;
-mod solve_hints;
+mod solve_text;
 pub(crate) mod start;
 pub(crate) mod sweep;
 pub(crate) mod sweep_summary;

@@ -19,19 +19,6 @@ pub(crate) fn quantity_json(model: &Model, q: Option<QuantityError>) -> Value {
     }
 }
 
-/// `worst_quantity` and `worst_force` of `e` as JSON fields.
-pub(crate) fn estimate_fields(model: &Model, e: &ErrorEstimate) -> Value {
-    json!({
-        "worst_quantity": quantity_json(model, e.worst_quantity),
-        "worst_force": quantity_json(model, e.worst_force),
-        "quadrature": e.quadrature.map(|q| json!({
-            "relative": q.relative,
-            "samples": q.samples,
-            "reference_samples": q.reference_samples,
-        })),
-    })
-}
-
 /// `"; worst quantity u(mesh) 1.8e-2 of its range 4.1e-5, force f(mesh) 2.2e-2"`, or
 /// nothing where the quantities were not estimated; with `"; contact quadrature 3.1e-8 of
 /// the load (...)"` where a law's crossings take the corrected trapezoid rule.

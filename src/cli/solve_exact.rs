@@ -1,23 +1,8 @@
-//! What `hbal solve` does differently for the exact piecewise solution: its multipliers are
-//! those of the exact monodromy matrix, its extremes those of the closed form in time.
+//! The exact piecewise solution's time series for `hbal solve --out` (its multipliers, those
+//! of the exact monodromy matrix, and its extremes, those of the closed form, come from the
+//! library).
 
-use hbal::report::ElementOutput;
-use hbal::solve::piecewise::{ExactExtremes, ExactSolution};
-
-/// The element outputs with the exact extremes and mean forces where there are some.
-pub(crate) fn element_outputs(
-    outputs: Vec<ElementOutput>,
-    extremes: Option<&ExactExtremes>,
-) -> Vec<ElementOutput> {
-    match extremes {
-        Some(x) => outputs
-            .into_iter()
-            .zip(&x.elements)
-            .map(|(o, e)| o.with_exact(e))
-            .collect(),
-        None => outputs,
-    }
-}
+use hbal::solve::piecewise::ExactSolution;
 
 /// The exact time series for `--out`, resolving the fastest natural motion (at 60 rpm the
 /// two-shaft model's ringing after every jump, which the harmonics 0..32 do not hold); `None`

@@ -10,6 +10,7 @@ mod common;
 
 mod accuracy_estimate;
 mod aft;
+mod analysis_solve;
 mod bad_input;
 mod band_limited;
 mod branch_switching;

@@ -1,0 +1,34 @@
+//! Whole analyses of a scene, as the command line runs them, returning one typed result each:
+//! the layer every front end (the CLI, the HTML report, a binding, a batch runner) calls
+//! instead of arranging the library's pieces itself.
+//!
+//! - [`solve()`]: one periodic solution with the method's fallbacks, automatic harmonics or
+//!   the exact piecewise method, the error estimate, Floquet stability where it is available,
+//!   the extremes and the element outputs, and the notes a user should read
+//!   ([`SolveAnalysis`]; its serde form is `hbal solve --json`).
+//!
+//! ```
+//! use hbal::analysis::{solve, SolveSettings};
+//! use hbal::scene::Scene;
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let scene = Scene::load(std::path::Path::new(concat!(
+//!     env!("CARGO_MANIFEST_DIR"),
+//!     "/examples/scenes/duffing.toml"
+//! )))?;
+//! let analysis = solve(&scene, &SolveSettings::default())?;
+//! assert!(analysis.solution.is_converged());
+//! assert_eq!(analysis.stable(), Some(true));
+//! assert_eq!(analysis.exit_code(), 0);
+//! // What `hbal solve --json` prints:
+//! let json = serde_json::to_value(&analysis)?;
+//! assert_eq!(json["converged"], true);
+//! # Ok(())
+//! # }
+//! ```
+
+mod element_record;
+mod solve;
+mod solve_record;
+
+pub use element_record::order_of;
+pub use solve::{solve, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};
