@@ -86,3 +86,8 @@ pub use solve::{Anderson, Broyden, FixedPoint, Method, Newton};
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+
+/// docs/library.md's code blocks run as doctests too.
+#[doc = include_str!("../docs/library.md")]
+#[cfg(doctest)]
+pub struct LibraryDocDoctests;
