@@ -6,6 +6,7 @@
 //!   the exact piecewise method, the error estimate, Floquet stability where it is available,
 //!   the extremes and the element outputs, and the notes a user should read
 //!   ([`SolveAnalysis`]; its serde form is `hbal solve --json`).
+//! - [`check_speed`]: the options every subcommand shares, checked before any work.
 //!
 //! ```
 //! use hbal::analysis::{solve, SolveSettings};
@@ -27,8 +28,10 @@
 //! ```
 
 mod element_record;
+mod options;
 mod solve;
 mod solve_record;
 
 pub use element_record::order_of;
+pub use options::{check_speed, check_sweep_start};
 pub use solve::{solve, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};

@@ -154,6 +154,9 @@ impl SolveAnalysis {
 /// Bad input (a start with automatic harmonics, what the model or basis refuses) and a solve
 /// that fails outright; a solve that ends unconverged is a result, marked.
 pub fn solve(scene: &Scene, settings: &SolveSettings) -> Result<SolveAnalysis> {
+    if let Some((q, label)) = &settings.start {
+        check_start(scene, q, label)?;
+    }
     let started = Instant::now();
     let mut notes = Vec::new();
     let mut found_by = None;
@@ -256,6 +259,37 @@ pub fn solve(scene: &Scene, settings: &SolveSettings) -> Result<SolveAnalysis> {
         quantity_names,
         exact,
     })
+}
+
+/// Checks start harmonics before any work: `n (H + 1)` of them, each part finite and at most
+/// 1e100 in magnitude, so a start that would overflow the residual is bad input.
+fn check_start(scene: &Scene, q: &[Complex64], label: &str) -> Result<()> {
+    let n = scene.model.n_dofs();
+    let want = n * (scene.basis.harmonics() + 1);
+    let bad = |reason: String| Error::InvalidOptions {
+        option: "--start".into(),
+        reason: format!("{label}: {reason}"),
+    };
+    if q.len() != want {
+        return Err(bad(format!(
+            "{} harmonics given, {want} expected (n (H + 1) = {n} ({}))",
+            q.len(),
+            scene.basis.harmonics() + 1
+        )));
+    }
+    let dofs = scene.model.dof_names();
+    if let Some((j, v)) = q.iter().enumerate().find(|(_, v)| {
+        !(v.re.abs() <= crate::error::MAX_MAGNITUDE && v.im.abs() <= crate::error::MAX_MAGNITUDE)
+    }) {
+        return Err(bad(format!(
+            "harmonic {} of `{}` is {:.3e} {:+.3e}i: each part must be finite and at most 1e100 in magnitude",
+            j / n,
+            dofs[j % n],
+            v.re,
+            v.im
+        )));
+    }
+    Ok(())
 }
 
 /// The stability of a converged orbit where it is asked for and available.

@@ -187,5 +187,11 @@ pub(crate) fn compare(
         )
         .unwrap_or_else(super::plot_warning);
     }
+    if !any_converged {
+        eprintln!(
+            "error: {}: no method converged (the table and the time-domain reference stand)",
+            scene.file
+        );
+    }
     Ok(if any_converged { 0 } else { 1 })
 }

@@ -30,7 +30,10 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     }
     let speed = scene.basis.omega() / scene.omega_per_speed;
     let (from, to) = (opts.from.unwrap_or(0.0), opts.to.unwrap_or(2.0 * speed));
-    if !(from.is_finite() && to.is_finite() && from >= 0.0 && to > from) {
+    hbal::analysis::check_speed(&scene, "--from", from, true)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    hbal::analysis::check_speed(&scene, "--to", to, false).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if to <= from {
         return Err(anyhow::anyhow!(
             "--from {from} --to {to}: need 0 <= from < to (in {})",
             scene.speed_unit
@@ -53,6 +56,23 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
         .solve(&hb, None, &mut hb.workspace())
         .map_err(|e| super::failure(e, &scene.file))?;
     if !sol.is_converged() {
+        if opts.json && opts.capture.is_none() {
+            // The document still comes, marked: what failed instead of the modes (the
+            // report says it in its page instead).
+            super::emit(
+                json!({
+                    "scene": scene.file,
+                    "unit": scene.speed_unit,
+                    "operating_speed": speed,
+                    "converged": false,
+                    "termination": sol.termination.to_string(),
+                    "error": "the operating point did not converge: no linearisation",
+                    "modes": [],
+                    "critical_speeds": [],
+                }),
+                opts.capture,
+            );
+        }
         return Err(Failure {
             code: 1,
             error: anyhow::anyhow!(
@@ -87,6 +107,7 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
             "scene": scene.file,
             "unit": unit,
             "operating_speed": speed,
+            "converged": true,
             "rigid_modes": nf.rigid,
             "modes": nf.mean.iter().enumerate().map(|(i, f)| json!({
                 "mean_hz": f,

@@ -53,6 +53,12 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
     if opts.output.is_some() && opts.to.is_none() {
         return Err(anyhow::anyhow!("--output chooses the run-up's plots: give --to").into());
     }
+    for (name, value) in [("--from", opts.from), ("--to", opts.to)] {
+        if let Some(v) = value {
+            hbal::analysis::check_speed(&scene, name, v, false)
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+        }
+    }
     super::order_cuts::choose(&scene, opts.output)?;
     for dof in scene.model.dof_names() {
         super::file_name_part(dof, "DOF")?;

@@ -151,14 +151,10 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             / per
     });
     for (name, v) in [("--from", from), ("--to", to)] {
-        if !(v.is_finite() && v > 0.0 && hbal::error::in_magnitude_range(v * per)) {
-            return Err(anyhow::anyhow!(
-                "{name} must be a finite speed > 0 ({unit}) whose fundamental is within 1e-100 to 1e100 rad/s, got {}",
-                hbal::report::significant(v, 6)
-            )
-            .into());
-        }
+        hbal::analysis::check_speed(&scene, name, v, false).map_err(|e| anyhow::anyhow!("{e}"))?;
     }
+    hbal::analysis::check_sweep_start(&scene, from * per, args.formulation)
+        .map_err(|e| super::failure(e, &scene.file))?;
     if !(max_step.is_finite() && max_step > 0.0) {
         return Err(anyhow::anyhow!("--max-step must be finite and > 0, got {max_step}").into());
     }

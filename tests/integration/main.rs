@@ -51,6 +51,7 @@ mod matrix_import_bad_input;
 mod modes;
 mod new_laws;
 mod nlvib_03;
+mod options_contract;
 mod order_cuts;
 mod piecewise_exact;
 mod piecewise_exact_cli;

@@ -1,0 +1,54 @@
+//! Checks of an analysis's options made once, before any work, the same way for every front
+//! end and subcommand: a problem is bad input (`Error::InvalidOptions`, exit code 2), never a
+//! failure found after a solve has run.
+
+use crate::scene::Scene;
+use crate::{Error, Result};
+
+/// Checks the speed option `name` (`--from`, `--to`, in the scene's unit): finite, above 0 (or
+/// 0 where `zero_allowed`), and its fundamental within 1e-100 to 1e100 rad/s.
+///
+/// ```
+/// # use hbal::scene::Scene;
+/// # let scene = Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/duffing.toml"))).unwrap();
+/// use hbal::analysis::check_speed;
+/// assert!(check_speed(&scene, "--to", 2.0, false).is_ok());
+/// assert!(check_speed(&scene, "--from", 0.0, true).is_ok());
+/// for bad in [f64::NAN, f64::INFINITY, -1.0, 0.0, 1e300] {
+///     let e = check_speed(&scene, "--to", bad, false).unwrap_err();
+///     assert!(e.to_string().starts_with("--to must be a finite speed"), "{e}");
+/// }
+/// ```
+pub fn check_speed(scene: &Scene, name: &str, value: f64, zero_allowed: bool) -> Result<()> {
+    let fundamental = value * scene.omega_per_speed;
+    let ok = value.is_finite()
+        && ((zero_allowed && value == 0.0)
+            || (value > 0.0 && crate::error::in_magnitude_range(fundamental)));
+    if ok {
+        return Ok(());
+    }
+    Err(Error::InvalidOptions {
+        option: name.into(),
+        reason: format!(
+            "must be a finite speed {} ({}) whose fundamental is within 1e-100 to 1e100 rad/s, got {}",
+            if zero_allowed { ">= 0" } else { "> 0" },
+            scene.speed_unit,
+            crate::report::significant(value, 6)
+        ),
+    })
+}
+
+/// Checks that a sweep of `scene` can start at `omega` (rad/s) with `formulation`: what a
+/// solve at that speed would refuse as bad input (a load or mesh order above H, static loads
+/// that do not balance, a singular static stiffness, a model too large for the dense
+/// Jacobian the continuation's corrector uses) is refused before the sweep, not found at its
+/// first point. The exact piecewise method, which needs no harmonic balance, and automatic
+/// harmonics, which raise H to the orders first, are not checked here.
+pub fn check_sweep_start(scene: &Scene, omega: f64, formulation: crate::Formulation) -> Result<()> {
+    if matches!(scene.method, crate::solve::Method::PiecewiseExact(_)) || scene.auto.is_some() {
+        return Ok(());
+    }
+    let basis = scene.basis.with_omega(omega)?;
+    let hb = crate::HarmonicBalance::with_formulation(&scene.model, basis, formulation)?;
+    crate::solve::check_dense_for_continuation(&hb)
+}

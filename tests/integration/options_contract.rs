@@ -1,0 +1,166 @@
+//! One contract for the options every subcommand shares (issue 32, bad input): a speed that is
+//! not a finite positive number within range, and a scene a solve refuses, are bad input
+//! (exit 2, nothing written) for `solve`, `sweep`, `modes` and `report` alike, found before any
+//! work.
+
+use crate::common::cli::temp_dir;
+use crate::common::hbal;
+use std::path::Path;
+
+const TWO_SHAFT: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/examples/scenes/two_shaft_6000rpm.toml"
+);
+
+fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// `report --to NaN` (or inf, -1) is refused before the solve and modes parts run: exit 2, one
+/// error, no directory; `modes` and `sweep` refuse speeds out of range with the same message.
+#[test]
+fn a_bad_speed_is_refused_before_any_work_by_every_subcommand() {
+    let dir = temp_dir("options_contract_report");
+    let out_dir = dir.join("report");
+    for bad in ["NaN", "inf", "-1", "1e300"] {
+        let to = format!("--to={bad}");
+        let out = hbal(&["report", TWO_SHAFT, &to, "--out", out_dir.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "report {bad}: {}", stderr(&out));
+        let err = stderr(&out);
+        assert_eq!(err.matches("error:").count(), 1, "{err}");
+        assert!(
+            err.contains("--to must be a finite speed > 0 (rpm)"),
+            "{err}"
+        );
+        assert!(!err.contains("report: solving"), "{err}");
+        assert!(
+            !out_dir.exists(),
+            "report {bad} wrote {}",
+            out_dir.display()
+        );
+        for command in ["modes", "sweep"] {
+            let out = hbal(&[command, TWO_SHAFT, &to]);
+            assert_eq!(
+                out.status.code(),
+                Some(2),
+                "{command} {bad}: {}",
+                stderr(&out)
+            );
+            assert!(
+                stderr(&out).contains("--to must be a finite speed > 0 (rpm)"),
+                "{command} {bad}: {}",
+                stderr(&out)
+            );
+        }
+    }
+    // `modes` alone may start at 0 rpm.
+    let out = hbal(&["modes", TWO_SHAFT, "--from", "0", "--to", "9000", "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+}
+
+fn write_scene(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// A scene `solve` refuses with exit 2 (a load above H, static loads that do not balance) is
+/// refused by `sweep` the same way, before its first point, instead of exit 1 with nothing on
+/// stdout.
+#[test]
+fn a_sweep_refuses_what_a_solve_refuses() {
+    let dir = temp_dir("options_contract_sweep");
+    let h0 = write_scene(
+        &dir,
+        "h0.toml",
+        r#"dofs = ["x"]
+mass = [[1.0]]
+damping = [[0.02]]
+stiffness = [[1.0]]
+fundamental = { rad_s = 1.2 }
+harmonics = { count = 0 }
+loads = [{ dof = "x", order = 1, cos = 0.1 }]
+"#,
+    );
+    let unbalanced = write_scene(
+        &dir,
+        "unbalanced.toml",
+        r#"dofs = ["a", "b"]
+mass = [[1.0, 0.0], [0.0, 1.0]]
+damping = [[0.1, -0.1], [-0.1, 0.1]]
+stiffness = [[1.0, -1.0], [-1.0, 1.0]]
+fundamental = { rad_s = 1.2 }
+harmonics = { count = 4 }
+loads = [{ dof = "a", order = 0, cos = 1.0 }, { dof = "a", order = 1, cos = 0.1 }]
+"#,
+    );
+    for (scene, what) in [
+        (&h0, "only 0 harmonics are kept"),
+        (&unbalanced, "the static loads do not balance"),
+    ] {
+        let solve = hbal(&["solve", scene, "--json"]);
+        let sweep = hbal(&["sweep", scene, "--to", "1.5", "--json"]);
+        for (name, out) in [("solve", &solve), ("sweep", &sweep)] {
+            assert_eq!(
+                out.status.code(),
+                Some(2),
+                "{name} {scene}: {}",
+                stderr(out)
+            );
+            assert!(stderr(out).contains(what), "{name}: {}", stderr(out));
+            assert!(out.stdout.is_empty(), "{name}");
+        }
+    }
+}
+
+/// A start file whose harmonics would overflow the residual is bad input (exit 2, named),
+/// not a numerical failure with nothing on stdout.
+#[test]
+fn a_start_that_would_overflow_is_bad_input() {
+    let dir = temp_dir("options_contract_start");
+    let out = hbal(&["solve", TWO_SHAFT, "--json"]);
+    let mut doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    doc["dofs"][0]["harmonics"][1]["cos"] = serde_json::json!(1e300);
+    let start = dir.join("start.json");
+    std::fs::write(&start, doc.to_string()).unwrap();
+    let out = hbal(&[
+        "solve",
+        TWO_SHAFT,
+        "--start",
+        start.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("harmonic 1 of `gear` is 1.000e300"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(out.stdout.is_empty());
+}
+
+/// Where the operating point or every method fails to converge, `modes --json` and
+/// `compare --json` still print their one document, marked, and say so on stderr (exit 1).
+#[test]
+fn unconverged_modes_and_compare_print_a_marked_document_and_an_error() {
+    let backlash = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/scenes/gear_backlash.toml"
+    );
+    for command in ["modes", "compare"] {
+        let out = hbal(&[command, backlash, "--method", "fixed_point", "--json"]);
+        assert_eq!(out.status.code(), Some(1), "{command}: {}", stderr(&out));
+        let doc: serde_json::Value =
+            serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{command}: {e}"));
+        let converged = match command {
+            "modes" => doc["converged"].clone(),
+            _ => doc["methods"][0]["converged"].clone(),
+        };
+        assert_eq!(converged, serde_json::json!(false), "{command}: {doc}");
+        assert!(
+            stderr(&out).contains("error:"),
+            "{command}: {}",
+            stderr(&out)
+        );
+    }
+}
