@@ -33,5 +33,5 @@ mod solve;
 mod solve_record;
 
 pub use element_record::order_of;
-pub use options::{check_speed, check_sweep_start};
+pub use options::{check, check_speed, check_sweep_start};
 pub use solve::{solve, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};

@@ -42,13 +42,32 @@ pub fn check_speed(scene: &Scene, name: &str, value: f64, zero_allowed: bool) ->
 /// solve at that speed would refuse as bad input (a load or mesh order above H, static loads
 /// that do not balance, a singular static stiffness, a model too large for the dense
 /// Jacobian the continuation's corrector uses) is refused before the sweep, not found at its
-/// first point. The exact piecewise method, which needs no harmonic balance, and automatic
-/// harmonics, which raise H to the orders first, are not checked here.
+/// first point. The exact piecewise method, which needs no harmonic balance, is not checked
+/// here.
 pub fn check_sweep_start(scene: &Scene, omega: f64, formulation: crate::Formulation) -> Result<()> {
-    if matches!(scene.method, crate::solve::Method::PiecewiseExact(_)) || scene.auto.is_some() {
+    if matches!(scene.method, crate::solve::Method::PiecewiseExact(_)) {
         return Ok(());
     }
-    let basis = scene.basis.with_omega(omega)?;
-    let hb = crate::HarmonicBalance::with_formulation(&scene.model, basis, formulation)?;
+    let hb = harmonic_balance(scene, scene.basis.with_omega(omega)?, formulation)?;
     crate::solve::check_dense_for_continuation(&hb)
+}
+
+/// Checks `scene` as a solve would before its first iteration (`hbal check`): its harmonic
+/// balance builds at the scene's speed, with automatic harmonics at their first level (H
+/// raised to the load and mesh orders).
+pub fn check(scene: &Scene) -> Result<()> {
+    harmonic_balance(scene, scene.basis, crate::Formulation::Auto).map(|_| ())
+}
+
+/// The harmonic balance a solve of `scene` at `basis` starts with.
+fn harmonic_balance(
+    scene: &Scene,
+    basis: crate::HarmonicBasis,
+    formulation: crate::Formulation,
+) -> Result<crate::HarmonicBalance<'_>> {
+    let basis = match &scene.auto {
+        Some(auto) => crate::solve::auto_first_basis(&scene.model, basis, auto)?,
+        None => basis,
+    };
+    crate::HarmonicBalance::with_formulation(&scene.model, basis, formulation)
 }

@@ -2,14 +2,11 @@
 //! solving, and print a one-line summary.
 
 use super::{load, Failure};
-use anyhow::Context;
-use hbal::HarmonicBalance;
 use std::path::Path;
 
 pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
     let scene = load(path, &super::SolverArgs::default())?;
-    HarmonicBalance::with_formulation(&scene.model, scene.basis, hbal::Formulation::Auto)
-        .with_context(|| scene.file.clone())?;
+    hbal::analysis::check(&scene).map_err(|e| super::failure(e, &scene.file))?;
     say!(
         "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s (order {} of the {} speed), H = {}, \
          N = {}, solver {})",

@@ -322,28 +322,14 @@ pub struct AutoSolution {
     pub found_by: Option<String>,
 }
 
-/// Solves `model` at H = H0, 2 H0, ... from `basis` (its Ω, its H as H0 and its samples per
-/// harmonic) with `method` (falling back to the other solvers and a load homotopy at the
-/// first level), until the estimated error of a level is at most `auto.tolerance`.
-///
-/// The tail correction ([`HarmonicBasis::with_tail_correction`]) is on unless `basis` turns
-/// it off: where a coefficient jumps in time it reaches a tolerance at a much lower H (the
-/// two-shaft model at 6000 rpm: 1e-6 at H = 32 instead of 512).
-pub fn solve_auto(
+/// The first level of automatic harmonics for `basis`: H doubled from the scene's count (at
+/// least 1) until every load and mesh order of `model` is present, at most `auto`'s cap;
+/// an error where the cap is below those orders.
+pub fn auto_first_basis(
     model: &Model,
     basis: HarmonicBasis,
-    method: &Method,
-    auto: AutoHarmonics,
-) -> Result<AutoSolution> {
-    let basis = basis.with_tail_correction(basis.tail_correction_setting().unwrap_or(true));
-    if !(auto.tolerance.is_finite() && auto.tolerance > 0.0) {
-        return Err(Error::invalid(
-            "harmonics",
-            "tolerance",
-            auto.tolerance,
-            "finite and > 0",
-        ));
-    }
+    auto: &AutoHarmonics,
+) -> Result<HarmonicBasis> {
     // Start with every order present (a mesh order above the first H would be refused).
     let orders = model.max_order() * basis.subharmonic();
     if auto.max_harmonics < orders {
@@ -367,6 +353,32 @@ pub fn solve_auto(
             format!(">= the starting H {}", basis.harmonics()),
         ));
     }
+    Ok(basis)
+}
+
+/// Solves `model` at H = H0, 2 H0, ... from `basis` (its Ω, its H as H0 and its samples per
+/// harmonic) with `method` (falling back to the other solvers and a load homotopy at the
+/// first level), until the estimated error of a level is at most `auto.tolerance`.
+///
+/// The tail correction ([`HarmonicBasis::with_tail_correction`]) is on unless `basis` turns
+/// it off: where a coefficient jumps in time it reaches a tolerance at a much lower H (the
+/// two-shaft model at 6000 rpm: 1e-6 at H = 32 instead of 512).
+pub fn solve_auto(
+    model: &Model,
+    basis: HarmonicBasis,
+    method: &Method,
+    auto: AutoHarmonics,
+) -> Result<AutoSolution> {
+    let basis = basis.with_tail_correction(basis.tail_correction_setting().unwrap_or(true));
+    if !(auto.tolerance.is_finite() && auto.tolerance > 0.0) {
+        return Err(Error::invalid(
+            "harmonics",
+            "tolerance",
+            auto.tolerance,
+            "finite and > 0",
+        ));
+    }
+    let basis = auto_first_basis(model, basis, &auto)?;
     if let Method::PiecewiseExact(exact) = method {
         return auto_exact(model, basis, exact, auto);
     }

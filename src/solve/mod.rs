@@ -27,8 +27,8 @@ pub(crate) use time_invariant::{omega_slope, time_invariant_estimate, time_invar
 
 pub(crate) use accuracy::refine;
 pub use accuracy::{
-    estimate_error, refined_solution, solve_auto, AutoHarmonics, AutoSolution, Control,
-    ErrorEstimate, Level,
+    auto_first_basis, estimate_error, refined_solution, solve_auto, AutoHarmonics, AutoSolution,
+    Control, ErrorEstimate, Level,
 };
 pub use anderson::{Anderson, AndersonSolver};
 pub use broyden::{Broyden, BroydenSolver, InitialJacobian};

@@ -164,3 +164,43 @@ fn unconverged_modes_and_compare_print_a_marked_document_and_an_error() {
         );
     }
 }
+
+/// `hbal check` accepts what `hbal solve` accepts: automatic harmonics whose first count is
+/// below a mesh order (the solve raises H to the orders first; check refused it with exit 2).
+#[test]
+fn check_accepts_automatic_harmonics_below_the_mesh_order() {
+    let dir = temp_dir("options_contract_check");
+    let scene = write_scene(
+        &dir,
+        "auto.toml",
+        r#"dofs = ["x"]
+mass = [[1.0]]
+damping = [[0.1]]
+fundamental = { rad_s = 0.7 }
+harmonics = { count = 2, auto = true }
+loads = [{ dof = "x", order = 0, cos = 0.1 }, { dof = "x", order = 1, cos = 0.05 }]
+
+[[elements]]
+name = "contact"
+type = "backlash"
+connects = { x = 1.0 }
+half_backlash = 1.0
+teeth = 5
+stiffness = { shape = "cosine", mean = 1.0, amplitude = 0.2 }
+"#,
+    );
+    for command in ["check", "solve"] {
+        let out = hbal(&[command, &scene]);
+        assert_eq!(out.status.code(), Some(0), "{command}: {}", stderr(&out));
+    }
+    // Below the orders with a cap that cannot reach them: both refuse.
+    let capped = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("auto = true", "auto = true, max = 4");
+    let capped = write_scene(&dir, "capped.toml", &capped);
+    for command in ["check", "solve"] {
+        let out = hbal(&[command, &capped]);
+        assert_eq!(out.status.code(), Some(2), "{command}: {}", stderr(&out));
+        assert!(stderr(&out).contains(">= 5"), "{command}: {}", stderr(&out));
+    }
+}
