@@ -351,7 +351,7 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => ExitCode::from(code),
         Err(f) => {
-            eprintln!("error: {:#}", f.error);
+            eprintln!("error: {}", cli::printable(&format!("{:#}", f.error)));
             ExitCode::from(f.code)
         }
     }

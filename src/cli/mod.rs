@@ -268,6 +268,21 @@ pub(crate) fn check_finite(f: &Floquet) -> Result<(), String> {
     }
 }
 
+/// `text` with its control characters (other than line breaks and tabs) written as `\u{1b}`
+/// escapes: a scene's names or a command-line value echoed in a message cannot move the
+/// terminal's cursor or colour it.
+pub(crate) fn printable(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() && c != '\n' && c != '\t' {
+                c.escape_unicode().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// A multiplier modulus for the text summaries: 6 decimals, or 4 significant digits under 1e-3.
 pub(crate) fn modulus(x: f64) -> String {
     if x == 0.0 || x >= 1e-3 {

@@ -163,7 +163,16 @@ impl Scene {
             path,
             message,
         };
-        if let Some((path, x)) = out_of_range(&value, String::new()) {
+        // Types and field names first (an unknown field, a whole number given as 1e300, are
+        // named as such), then the magnitude of every number before anything is built.
+        let range = out_of_range(&value, String::new());
+        let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
+            let path = e.path().to_string();
+            let message = whole_numbers_named(&e.into_inner().to_string());
+            let path = field_path(path, &message);
+            err(None, (path != ".").then_some(path), message)
+        })?;
+        if let Some((path, x)) = range {
             return Err(err(
                 None,
                 Some(path),
@@ -174,12 +183,6 @@ impl Scene {
                 ),
             ));
         }
-        let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
-            let path = e.path().to_string();
-            let message = e.into_inner().to_string();
-            let path = field_path(path, &message);
-            err(None, (path != ".").then_some(path), message)
-        })?;
         parsed.build(file)
     }
 
@@ -340,4 +343,14 @@ pub fn known_types() -> String {
     "linear_spring, mesh_stiffness, backlash, cubic_spring, gap_contact, stop_spring, friction, jenkins, \
      quadratic_damper, polynomial_spring, gear_stage"
         .to_string()
+}
+
+/// serde's names of whole-number types in a message, as a user reads them ("expected usize"
+/// says nothing to an engineer).
+fn whole_numbers_named(message: &str) -> String {
+    ["usize", "u64", "u32", "u16", "u8"]
+        .iter()
+        .fold(message.to_string(), |m, t| {
+            m.replace(&format!("expected {t}"), "expected a whole number >= 0")
+        })
 }

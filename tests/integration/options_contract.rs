@@ -204,3 +204,44 @@ stiffness = { shape = "cosine", mean = 1.0, amplitude = 0.2 }
         assert!(stderr(&out).contains(">= 5"), "{command}: {}", stderr(&out));
     }
 }
+
+/// Messages say what is wrong in the user's terms: an unknown field is unknown (not "out of
+/// range" because of its value), a whole-number field given 1e300 asks for a whole number, and
+/// a control character echoed from the input is escaped, not sent to the terminal.
+#[test]
+fn messages_name_the_problem_and_escape_control_characters() {
+    let dir = temp_dir("options_contract_messages");
+    let duffing = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/scenes/duffing.toml"
+    ))
+    .unwrap();
+    let unknown = write_scene(&dir, "unknown.toml", &format!("foo = 1e300\n{duffing}"));
+    let whole = write_scene(
+        &dir,
+        "whole.toml",
+        &duffing.replace("harmonics = { count = 7 }", "harmonics = { count = 1e300 }"),
+    );
+    let huge = write_scene(&dir, "huge.toml", &duffing.replace("k = 1.0", "k = 1e300"));
+    for (scene, want) in [
+        (&unknown, "unknown field `foo`"),
+        (
+            &whole,
+            "harmonics.count: invalid type: floating point `1e+300`, expected a whole number >= 0",
+        ),
+        (
+            &huge,
+            "elements[0].k: must be 0 or between 1e-100 and 1e100 in magnitude",
+        ),
+    ] {
+        let out = hbal(&["solve", scene]);
+        assert_eq!(out.status.code(), Some(2), "{scene}");
+        assert!(stderr(&out).contains(want), "{scene}: {}", stderr(&out));
+    }
+    let valid = write_scene(&dir, "valid.toml", &duffing);
+    let out = hbal(&["solve", &valid, "--method", "ne\u{1b}[31mw"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(!err.contains('\u{1b}'), "{err:?}");
+    assert!(err.contains("ne\\u{1b}[31mw"), "{err}");
+}
