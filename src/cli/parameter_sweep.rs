@@ -4,7 +4,6 @@
 //! the first value and kept), and optionally branch.csv and one parameter-response SVG per DOF.
 
 use super::{basis_with, Failure, SolverArgs};
-use anyhow::Context;
 use hbal::scene::Scene;
 use serde_json::json;
 use std::path::Path;
@@ -48,8 +47,8 @@ pub(crate) fn parameter_sweep(
         }
     }
     let file = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read the file"))?;
+    let text = hbal::scene::bounded_read::read_text(path)
+        .map_err(|e| anyhow::anyhow!("{file}: cannot read the file: {e}"))?;
     let doc = Scene::parse_value(&text, &file)?;
     if !(from.is_finite() && to.is_finite()) || points < 2 {
         return Err(anyhow::anyhow!("--from and --to must be finite and --points >= 2").into());

@@ -24,7 +24,7 @@ pub(crate) fn read(path: &Path, scene: &Scene) -> Result<Start, Failure> {
     let bad = |msg: String| -> Failure {
         anyhow::anyhow!("--start {file}: {msg} (expected the output of `hbal solve --json`)").into()
     };
-    let text = std::fs::read_to_string(path)
+    let text = hbal::scene::bounded_read::read_text(path)
         .map_err(|e| Failure::from(anyhow::anyhow!("--start {file}: cannot read the file: {e}")))?;
     let doc: Value =
         serde_json::from_str(&text).map_err(|e| bad(format!("not a JSON object: {e}")))?;

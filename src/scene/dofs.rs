@@ -164,7 +164,7 @@ pub(super) fn read(value: &Value, base: &Path) -> Result<Dofs, (String, String)>
 /// twice.
 fn sidecar(path: &Path) -> Result<Dofs, String> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path)
+    let text = super::bounded_read::read_text(path)
         .map_err(|e| format!("{file}: cannot read the DOF list: {e}"))?;
     let mut names: Vec<String> = Vec::new();
     let mut first_line = std::collections::HashMap::new();

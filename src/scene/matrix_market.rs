@@ -78,7 +78,7 @@ const SUPPORTED: &str = "hbal reads `%%MatrixMarket matrix coordinate real gener
 /// Reads and parses a Matrix Market file; errors name `path` as given.
 pub fn read(path: &Path) -> Result<CoordinateMatrix, MtxError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| MtxError {
+    let text = super::bounded_read::read_text(path).map_err(|e| MtxError {
         file: file.clone(),
         line: None,
         message: format!("cannot read the Matrix Market file: {e}"),

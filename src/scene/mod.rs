@@ -27,6 +27,7 @@
 //! assert!(err.to_string().contains("elements[0].alhpa"), "{err}");
 //! ```
 
+pub mod bounded_read;
 mod dofs;
 mod elements;
 pub mod export;
@@ -137,7 +138,7 @@ impl Scene {
     /// Reads and builds a scene; `.json` files are JSON, everything else TOML.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        let text = bounded_read::read_text(path).map_err(|e| SceneError {
             file: file.clone(),
             position: None,
             path: None,

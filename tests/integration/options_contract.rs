@@ -245,3 +245,25 @@ fn messages_name_the_problem_and_escape_control_characters() {
     assert!(!err.contains('\u{1b}'), "{err:?}");
     assert!(err.contains("ne\\u{1b}[31mw"), "{err}");
 }
+
+/// A file the scene names that never ends (`/dev/zero`) is refused at the size bound, exit 2,
+/// instead of read until memory runs out.
+#[cfg(unix)]
+#[test]
+fn an_endless_file_is_refused_at_the_size_bound() {
+    let dir = temp_dir("options_contract_endless");
+    let scene = write_scene(
+        &dir,
+        "endless.toml",
+        "dofs = { file = \"/dev/zero\" }\nmass = [[1.0]]\nfundamental = { rad_s = 1.0 }\nharmonics = { count = 2 }\n",
+    );
+    for args in [vec!["solve", scene.as_str()], vec!["solve", "/dev/zero"]] {
+        let out = hbal(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("larger than the limit of 256 MiB"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+}
