@@ -34,4 +34,4 @@ mod solve_record;
 
 pub use element_record::order_of;
 pub use options::{check, check_speed, check_sweep_start};
-pub use solve::{solve, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};
+pub use solve::{solve, AutoRecord, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};

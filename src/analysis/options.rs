@@ -41,14 +41,18 @@ pub fn check_speed(scene: &Scene, name: &str, value: f64, zero_allowed: bool) ->
 /// Checks that a sweep of `scene` can start at `omega` (rad/s) with `formulation`: what a
 /// solve at that speed would refuse as bad input (a load or mesh order above H, static loads
 /// that do not balance, a singular static stiffness, a model too large for the dense
-/// Jacobian the continuation's corrector uses) is refused before the sweep, not found at its
-/// first point. The exact piecewise method, which needs no harmonic balance, is not checked
+/// Jacobian the continuation's corrector uses, unless the model is linear time-invariant and
+/// needs none) is refused before the sweep, not found at its first point. The exact piecewise method, which needs no harmonic balance, is not checked
 /// here.
 pub fn check_sweep_start(scene: &Scene, omega: f64, formulation: crate::Formulation) -> Result<()> {
     if matches!(scene.method, crate::solve::Method::PiecewiseExact(_)) {
         return Ok(());
     }
     let hb = harmonic_balance(scene, scene.basis.with_omega(omega)?, formulation)?;
+    // A linear time-invariant model is swept by one solve per harmonic: no Jacobian.
+    if scene.model.is_linear_time_invariant() {
+        return Ok(());
+    }
     crate::solve::check_dense_for_continuation(&hb)
 }
 

@@ -59,6 +59,20 @@ pub enum StabilityOutcome {
     Failed(String),
 }
 
+/// Automatic harmonics as they ran.
+#[derive(Debug, Clone)]
+pub struct AutoRecord {
+    /// The settings (the scene's, with the analysis's formulation).
+    pub settings: AutoHarmonics,
+    /// Every level tried.
+    pub levels: Vec<Level>,
+    /// `true` where the tolerance was not reached (at the cap, or where a level failed).
+    pub capped: bool,
+    /// Where a level after the first failed: why (the solution is the last level's that
+    /// succeeded).
+    pub stopped: Option<String>,
+}
+
 /// Something the user should read beside the numbers.
 #[derive(Debug, Clone, PartialEq)]
 pub enum SolveNote {
@@ -97,9 +111,8 @@ pub struct SolveAnalysis {
     pub start: Option<String>,
     /// The error estimate (`None` for an unconverged iterate; the reason where it failed).
     pub estimate: Option<std::result::Result<ErrorEstimate, String>>,
-    /// Automatic harmonics: the settings, every level tried, and whether the tolerance was
-    /// not reached by the cap.
-    pub auto: Option<(AutoHarmonics, Vec<Level>, bool)>,
+    /// Automatic harmonics as they ran.
+    pub auto: Option<AutoRecord>,
     /// The exact piecewise solution's extremes from its closed form in time, where it answered.
     pub extremes: Option<ExactExtremes>,
     /// `max |q_i|` of every DOF (from the closed form where there is one).
@@ -133,7 +146,7 @@ impl SolveAnalysis {
 
     /// `true` where automatic harmonics stopped at the cap above the tolerance.
     pub fn capped(&self) -> bool {
-        matches!(&self.auto, Some((_, _, true)))
+        self.auto.as_ref().is_some_and(|a| a.capped)
     }
 
     /// The exit code of the contract: 0 for a converged orbit with its stability (where
@@ -164,7 +177,9 @@ pub fn solve(scene: &Scene, settings: &SolveSettings) -> Result<SolveAnalysis> {
     let mut auto = None;
     let mut switched = false;
     let mut start = settings.start.as_ref().map(|(_, label)| label.clone());
-    let (solution, estimate) = match scene.auto {
+    // The solve's wall time: the estimate of a fixed-H solve is not part of it (as before the
+    // analysis layer, and as docs/scenes.md says); automatic harmonics include theirs.
+    let (solution, estimate, solve_seconds) = match scene.auto {
         Some(mut settings_auto) => {
             settings_auto.formulation = settings.formulation;
             if settings.start.is_some() {
@@ -178,15 +193,28 @@ pub fn solve(scene: &Scene, settings: &SolveSettings) -> Result<SolveAnalysis> {
             found_by = a.found_by;
             exact = a.exact;
             switched = a.switched_to_exact;
-            auto = Some((settings_auto, a.levels, a.capped));
-            (a.solution, Some(Ok(a.estimate)))
+            auto = Some(AutoRecord {
+                settings: settings_auto,
+                levels: a.levels,
+                capped: a.capped,
+                stopped: a.stopped,
+            });
+            (
+                a.solution,
+                Some(Ok(a.estimate)),
+                started.elapsed().as_secs_f64(),
+            )
         }
         None if matches!(scene.method, Method::PiecewiseExact(_)) => {
             if start.take().is_some() {
                 notes.push(SolveNote::StartUnused);
             }
             let e = PiecewiseExact::new().solve_exact(&scene.model, &scene.basis)?;
-            let out = (e.solution.clone(), Some(Ok(e.estimate)));
+            let out = (
+                e.solution.clone(),
+                Some(Ok(e.estimate)),
+                started.elapsed().as_secs_f64(),
+            );
             exact = Some(e);
             out
         }
@@ -206,19 +234,19 @@ pub fn solve(scene: &Scene, settings: &SolveSettings) -> Result<SolveAnalysis> {
                 (scene.method.solve(&hb, initial, &mut ws)?, None)
             };
             found_by = how;
+            let seconds = started.elapsed().as_secs_f64();
             let estimate = solution.is_converged().then(|| {
                 crate::solve::estimate_error(&scene.model, &solution).map_err(|e| e.to_string())
             });
             if let Some(Ok(e)) = &estimate {
                 notes.extend(tail_correction_note(scene, &hb, e));
             }
-            (solution, estimate)
+            (solution, estimate, seconds)
         }
     };
     if let Some(Ok(e)) = &estimate {
         notes.extend(piecewise_note(scene, e));
     }
-    let solve_seconds = started.elapsed().as_secs_f64();
     let started = Instant::now();
     let stability = stability(scene, settings, &solution, exact.as_ref());
     let stability_seconds = started.elapsed().as_secs_f64();

@@ -27,12 +27,13 @@ impl SolveAnalysis {
                 Some(Ok(e)) => estimate_json(e, &self.quantity_names),
                 Some(Err(e)) => json!({"error": e}),
             },
-            "auto_harmonics": self.auto.as_ref().map(|(a, levels, capped)| json!({
-                "tolerance": a.tolerance,
-                "max": a.max_harmonics,
-                "control": a.control,
-                "reached": !capped,
-                "levels": levels,
+            "auto_harmonics": self.auto.as_ref().map(|a| json!({
+                "tolerance": a.settings.tolerance,
+                "max": a.settings.max_harmonics,
+                "control": a.settings.control,
+                "reached": !a.capped,
+                "stopped": a.stopped,
+                "levels": a.levels,
             })),
             // Where max_abs and the elements' extremes come from.
             "extremes_from": match &self.extremes {

@@ -143,7 +143,8 @@ fn report_failures(scene: &Scene, a: &SolveAnalysis) {
             scene.file, a.solution.termination
         );
     }
-    if let Some((auto, levels, true)) = &a.auto {
+    if let Some(record) = a.auto.as_ref().filter(|r| r.capped) {
+        let (auto, levels) = (&record.settings, &record.levels);
         // The quantity that limits it, where the estimate has one.
         let limiting = match &a.estimate {
             Some(Ok(e)) => e
@@ -158,6 +159,17 @@ fn report_failures(scene: &Scene, a: &SolveAnalysis) {
                 .unwrap_or_default(),
             _ => String::new(),
         };
+        if let Some(why) = &record.stopped {
+            eprintln!(
+                "error: {}: automatic harmonics stopped before the tolerance {:.0e}: {why}; H = {} is reported (estimated error of {} {:.1e}){limiting}",
+                scene.file,
+                auto.tolerance,
+                levels.last().map_or(0, |l| l.harmonics),
+                auto.control.what(),
+                levels.last().map_or(f64::NAN, |l| l.estimate),
+            );
+            return;
+        }
         eprintln!(
             "error: {}: automatic harmonics: the estimated error of {} {:.1e} is above the tolerance {:.0e} at the cap H = {} (harmonics.max){limiting}",
             scene.file,

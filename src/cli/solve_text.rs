@@ -78,9 +78,10 @@ pub(crate) fn print(scene: &Scene, a: &SolveAnalysis, asked: bool) {
 
 /// The automatic harmonics' levels and the switch to the exact method.
 fn print_auto(a: &SolveAnalysis) {
-    let Some((auto, levels, capped)) = &a.auto else {
+    let Some(record) = &a.auto else {
         return;
     };
+    let (auto, levels, capped) = (&record.settings, &record.levels, &record.capped);
     let steps: Vec<String> = levels
         .iter()
         .map(|l| format!("H = {} → {:.1e}", l.harmonics, l.estimate))
@@ -92,6 +93,12 @@ fn print_auto(a: &SolveAnalysis) {
         if *capped { " (NOT reached)" } else { "" },
         steps.join(", ")
     );
+    if let Some(why) = &record.stopped {
+        say!(
+            "  harmonics: stopped after H = {}: {why}; the last level that succeeded is reported",
+            levels.last().map_or(0, |l| l.harmonics)
+        );
+    }
     if a.switched_to_exact {
         say!(
             "  harmonic balance stopped at the cap H = {} above the tolerance; the scene is linear with piecewise-constant coefficients, so the exact piecewise solution answers instead (the levels after the cap are its own): its harmonics 0..H are exact, its time series and extremes come from its closed form in time",

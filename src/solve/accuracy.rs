@@ -320,6 +320,10 @@ pub struct AutoSolution {
     /// the linear solution (the other solvers, the load or speed homotopy, a higher H), with
     /// what failed before; `None` where it did.
     pub found_by: Option<String>,
+    /// Where a level after the first failed (its solve or its refinement at 2H): why.
+    /// `solution`, `estimate` and `levels` are then those of the levels that succeeded, and
+    /// `capped` is `true` (the tolerance was not reached).
+    pub stopped: Option<String>,
 }
 
 /// The first level of automatic harmonics for `basis`: H doubled from the scene's count (at
@@ -388,17 +392,43 @@ pub fn solve_auto(
         super::auto_start::first_level(model, level_basis, method, &auto)?;
     level_basis = *current.basis();
     let mut levels = Vec::new();
+    // The last level that succeeded, kept where a later one fails.
+    let mut last: Option<(Solution, ErrorEstimate)> = None;
     loop {
-        if !current.is_converged() {
-            return Err(Error::Solver {
-                reason: format!(
-                    "automatic harmonics: no converged solution with H = {} ({})",
-                    level_basis.harmonics(),
-                    current.termination
-                ),
-            });
-        }
-        let fine = reference(model, &current, auto.formulation)?;
+        let failed = if !current.is_converged() {
+            Err(format!(
+                "no converged solution with H = {} ({})",
+                level_basis.harmonics(),
+                current.termination
+            ))
+        } else {
+            reference(model, &current, auto.formulation).map_err(|e| {
+                format!(
+                    "the refinement of H = {} failed: {e}",
+                    level_basis.harmonics()
+                )
+            })
+        };
+        let fine = match (failed, last.take()) {
+            (Ok(fine), _) => fine,
+            (Err(reason), None) => {
+                return Err(Error::Solver {
+                    reason: format!("automatic harmonics: {reason}"),
+                })
+            }
+            (Err(reason), Some((solution, estimate))) => {
+                return Ok(AutoSolution {
+                    solution,
+                    estimate,
+                    levels,
+                    capped: true,
+                    exact: None,
+                    switched_to_exact: false,
+                    found_by,
+                    stopped: Some(reason),
+                })
+            }
+        };
         let estimate = compare(model, &current, &fine);
         levels.push(Level {
             harmonics: level_basis.harmonics(),
@@ -425,12 +455,30 @@ pub fn solve_auto(
                 exact: None,
                 switched_to_exact: false,
                 found_by,
+                stopped: None,
             });
         }
-        current = if fine.basis().harmonics() <= auto.max_harmonics {
-            fine
+        let next = if fine.basis().harmonics() <= auto.max_harmonics {
+            Ok(fine)
         } else {
-            refine(model, &current, auto.formulation)?
+            refine(model, &current, auto.formulation)
+        };
+        last = Some((current, estimate));
+        current = match next {
+            Ok(next) => next,
+            Err(e) => {
+                let (solution, estimate) = last.take().expect("just kept");
+                return Ok(AutoSolution {
+                    solution,
+                    estimate,
+                    levels,
+                    capped: true,
+                    exact: None,
+                    switched_to_exact: false,
+                    found_by,
+                    stopped: Some(format!("the next level failed: {e}")),
+                });
+            }
         };
         level_basis = *current.basis();
     }
@@ -502,6 +550,7 @@ fn auto_exact(
                 exact: Some(e),
                 switched_to_exact: false,
                 found_by: None,
+                stopped: None,
             });
         }
         level_basis = scaled(&level_basis, next)?;

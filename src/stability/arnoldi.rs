@@ -69,6 +69,11 @@ pub(crate) fn leading_eigenvalues(
         done = j + 1;
         let scale = column.iter().fold(beta, |a, c| a.max(c.abs()));
         let invariant = beta <= 1e-14 * scale.max(f64::MIN_POSITIVE);
+        // v_{j+1} before any stop: the relation Φ V_k = V_{k+1} H stays whole for the Ritz
+        // vector's image.
+        if !invariant {
+            basis.push(w.iter().map(|v| v / beta).collect());
+        }
         if invariant || done % CHECK_EVERY == 0 || done == m {
             values = ritz_values(&h, done);
             change = match &previous {
@@ -82,7 +87,6 @@ pub(crate) fn leading_eigenvalues(
             }
             previous = Some(values.clone());
         }
-        basis.push(w.iter().map(|v| v / beta).collect());
     }
     let (leading_vector, leading_image) = ritz_vector(&h, done, &basis, values.first().copied());
     Ok(Ritz {

@@ -267,3 +267,25 @@ fn an_endless_file_is_refused_at_the_size_bound() {
         );
     }
 }
+
+/// The start check refuses only what a sweep would refuse: a linear time-invariant scene
+/// above the dense-Jacobian size is swept by one solve per harmonic and needs no Jacobian
+/// (found by review: 1 DOF at H = 4100 was refused with exit 2).
+#[test]
+fn a_large_linear_sweep_is_not_refused_for_a_jacobian_it_does_not_need() {
+    let dir = temp_dir("options_contract_lti");
+    let scene = write_scene(
+        &dir,
+        "lti.toml",
+        r#"dofs = ["x"]
+mass = [[1.0]]
+damping = [[0.02]]
+stiffness = [[1.0]]
+fundamental = { rad_s = 0.5 }
+harmonics = { count = 4100 }
+loads = [{ dof = "x", order = 1, cos = 0.1 }]
+"#,
+    );
+    let out = hbal(&["sweep", &scene, "--to", "0.6", "--no-stability"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+}

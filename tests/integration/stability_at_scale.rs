@@ -177,3 +177,70 @@ fn arnoldi_gives_the_leading_dense_multipliers() {
         assert_eq!(arnoldi.is_stable(), dense.is_stable(), "{label}");
     }
 }
+
+/// A grazing contact with contact damping (a force that jumps at the kink): the refined
+/// integration of the Arnoldi action may find a crossing the coarse grid missed. The
+/// iteration then declines (an error naming what it needs, or the dense method under `Auto`)
+/// instead of panicking (found by review: contact excursions 4e-6 to 6e-4 panicked).
+#[test]
+fn arnoldi_declines_a_grazing_contact_with_contact_damping() {
+    use hbal::stability::Orbit;
+    let scene = |a: f64| {
+        hbal::scene::Scene::from_str(
+            &format!(
+                r#"dofs = ["x"]
+mass = [[1.0]]
+damping = [[0.1]]
+stiffness = [[1.0]]
+fundamental = {{ rad_s = 0.7 }}
+harmonics = {{ count = 16 }}
+loads = [{{ dof = "x", order = 1, cos = {a} }}]
+
+[[elements]]
+name = "contact"
+type = "backlash"
+connects = {{ x = 1.0 }}
+half_backlash = 1.0
+stiffness = {{ shape = "cosine", mean = 1.0, amplitude = 0.0 }}
+contact_damping = 0.05
+"#
+            ),
+            "graze",
+        )
+        .unwrap()
+    };
+    let excursion = |a: f64| {
+        let s = scene(a);
+        let solution = solve(&s.model, s.basis, Formulation::Full);
+        let top = hbal::report::element_outputs(&s.model, &solution).unwrap()[0]
+            .coordinate
+            .max;
+        (top - 1.0, s, solution)
+    };
+    for delta in [1e-5, 1e-4] {
+        let (mut lo, mut hi) = (0.3, 0.8);
+        for _ in 0..50 {
+            let mid = 0.5 * (lo + hi);
+            if excursion(mid).0 > delta {
+                hi = mid
+            } else {
+                lo = mid
+            }
+        }
+        let (d, s, solution) = excursion(hi);
+        assert!(d > 0.0 && d < 10.0 * delta, "excursion {d}");
+        let options = FloquetOptions {
+            orbit: Orbit::Harmonic,
+            ..FloquetOptions::default()
+        };
+        match options
+            .with_method(FloquetMethod::Arnoldi)
+            .compute(&s.model, &solution)
+        {
+            Ok(f) => assert!(f.max_abs().is_finite()),
+            Err(e) => assert!(e.to_string().contains("arnoldi"), "{e}"),
+        }
+        let auto = options.compute(&s.model, &solution).unwrap();
+        assert!(auto.is_stable(), "max |μ| {}", auto.max_abs());
+    }
+}

@@ -91,7 +91,7 @@ pub enum Breach {
 }
 
 /// Keys whose value may be `null` by the documented schema (docs/scenes.md).
-const NULLABLE: [&str; 11] = [
+const NULLABLE: [&str; 12] = [
     "auto_harmonics",
     "error_estimate",
     "found_by",
@@ -101,6 +101,7 @@ const NULLABLE: [&str; 11] = [
     "reduction",
     "stability",
     "start",
+    "stopped",
     "worst_force",
     "worst_quantity",
 ];
