@@ -125,8 +125,6 @@ pub struct SolveAnalysis {
     pub notes: Vec<SolveNote>,
     /// The scene's fundamental order relative to its reference speed.
     pub fundamental_order: f64,
-    /// The scene's reference speed per rad/s and its unit.
-    pub speed: (f64, String),
     /// Wall times of the solve (with the estimate) and of the stability, s.
     pub seconds: (f64, f64),
     /// Names of the worst quantity and the worst force of the estimate (for the record).
@@ -282,7 +280,6 @@ pub fn solve(scene: &Scene, settings: &SolveSettings) -> Result<SolveAnalysis> {
         stability,
         notes,
         fundamental_order: scene.fundamental_order,
-        speed: (scene.omega_per_speed, scene.speed_unit.to_string()),
         seconds: (solve_seconds, stability_seconds),
         quantity_names,
         exact,

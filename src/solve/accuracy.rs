@@ -417,16 +417,7 @@ pub fn solve_auto(
                 })
             }
             (Err(reason), Some((solution, estimate))) => {
-                return Ok(AutoSolution {
-                    solution,
-                    estimate,
-                    levels,
-                    capped: true,
-                    exact: None,
-                    switched_to_exact: false,
-                    found_by,
-                    stopped: Some(reason),
-                })
+                return Ok(hb_levels(solution, estimate, levels, found_by, Err(reason)))
             }
         };
         let estimate = compare(model, &current, &fine);
@@ -447,40 +438,42 @@ pub fn solve_auto(
             }
         }
         if reached || capped {
-            return Ok(AutoSolution {
-                solution: current,
-                estimate,
-                levels,
-                capped,
-                exact: None,
-                switched_to_exact: false,
-                found_by,
-                stopped: None,
-            });
+            return Ok(hb_levels(current, estimate, levels, found_by, Ok(capped)));
         }
         let next = if fine.basis().harmonics() <= auto.max_harmonics {
             Ok(fine)
         } else {
             refine(model, &current, auto.formulation)
         };
-        last = Some((current, estimate));
-        current = match next {
-            Ok(next) => next,
+        match next {
+            Ok(next) => last = Some((std::mem::replace(&mut current, next), estimate)),
             Err(e) => {
-                let (solution, estimate) = last.take().expect("just kept");
-                return Ok(AutoSolution {
-                    solution,
-                    estimate,
-                    levels,
-                    capped: true,
-                    exact: None,
-                    switched_to_exact: false,
-                    found_by,
-                    stopped: Some(format!("the next level failed: {e}")),
-                });
+                let why = Err(format!("the next level failed: {e}"));
+                return Ok(hb_levels(current, estimate, levels, found_by, why));
             }
-        };
+        }
         level_basis = *current.basis();
+    }
+}
+
+/// The result of harmonic balance's levels ending at `solution` with `estimate`: `Ok(capped)`
+/// where they ended normally, `Err(why)` where a later level failed (then capped, `stopped`).
+fn hb_levels(
+    solution: Solution,
+    estimate: ErrorEstimate,
+    levels: Vec<Level>,
+    found_by: Option<String>,
+    end: std::result::Result<bool, String>,
+) -> AutoSolution {
+    AutoSolution {
+        solution,
+        estimate,
+        levels,
+        capped: end.as_ref().map_or(true, |capped| *capped),
+        exact: None,
+        switched_to_exact: false,
+        found_by,
+        stopped: end.err(),
     }
 }
 
