@@ -164,9 +164,42 @@ pub enum Error {
         /// The integrator's reason.
         reason: String,
     },
+    /// A failure along an analysis whose input was checked before it started (a sweep's
+    /// later point: a singular dynamic stiffness, a failed setup): numerical, whatever the
+    /// inner error's kind ([`Error::exit_code`]).
+    #[error(transparent)]
+    AfterCheck(Box<Error>),
 }
 
 impl Error {
+    /// The exit code of the command-line contract: 1 for a numerical failure (a non-finite
+    /// value, a failed solver or integration, a failure along a checked analysis), 2 for bad
+    /// input (a model too large to set up is bad input wherever it is found).
+    ///
+    /// ```
+    /// use hbal::Error;
+    /// assert_eq!(Error::invalid("mass", "m", -1.0, ">= 0").exit_code(), 2);
+    /// assert_eq!(Error::NonFinite { what: "residual".into() }.exit_code(), 1);
+    /// let along = Error::AfterCheck(Box::new(Error::invalid("mass", "m", -1.0, ">= 0")));
+    /// assert_eq!(along.exit_code(), 1);
+    /// ```
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::NonFinite { .. } | Error::Solver { .. } | Error::TimeIntegration { .. } => 1,
+            Error::AfterCheck(inner) if matches!(**inner, Error::TooLarge { .. }) => 2,
+            Error::AfterCheck(_) => 1,
+            _ => 2,
+        }
+    }
+
+    /// `self` as a failure along an analysis whose input was checked ([`Error::AfterCheck`]).
+    pub fn after_check(self) -> Self {
+        match self {
+            Error::AfterCheck(_) => self,
+            e => Error::AfterCheck(Box::new(e)),
+        }
+    }
+
     /// Shorthand for [`Error::InvalidParameter`].
     pub fn invalid(
         context: impl Into<String>,

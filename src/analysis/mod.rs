@@ -6,6 +6,10 @@
 //!   the exact piecewise method, the error estimate, Floquet stability where it is available,
 //!   the extremes and the element outputs, and the notes a user should read
 //!   ([`SolveAnalysis`]; its serde form is `hbal solve --json`).
+//! - [`sweep()`]: a speed sweep through turning points, with stability, automatic harmonics
+//!   along the branch, the branches leaving it, every point's element outputs and where
+//!   contacts open ([`SweepAnalysis`]; its serde form is `hbal sweep --json`), progress to an
+//!   [`Observer`], stopped by the settings' [`Cancel`](crate::continuation::Cancel) token.
 //! - [`check_speed`]: the options every subcommand shares, checked before any work.
 //!
 //! ```
@@ -27,11 +31,25 @@
 //! # }
 //! ```
 
+mod branch_outputs;
 mod element_record;
+mod observer;
 mod options;
+mod output_choice;
 mod solve;
 mod solve_record;
+mod sweep;
+mod sweep_outcome;
+mod sweep_record;
+mod sweep_settings;
 
+pub use branch_outputs::{contact_loss, point_outputs, ContactLoss};
 pub use element_record::order_of;
+pub use observer::{Observer, Silent};
 pub use options::{check, check_speed, check_sweep_start};
+pub use output_choice::{reported_dofs, shown_output, Shown, ALL_DOFS_UP_TO};
 pub use solve::{solve, AutoRecord, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};
+pub use sweep::{sweep, SweepAnalysis};
+pub use sweep_outcome::SweepNote;
+pub use sweep_record::SCHEMA_VERSION;
+pub use sweep_settings::{SweepSettings, SweepStart};

@@ -288,7 +288,7 @@ pub fn solve(scene: &Scene, settings: &SolveSettings) -> Result<SolveAnalysis> {
 
 /// Checks start harmonics before any work: `n (H + 1)` of them, each part finite and at most
 /// 1e100 in magnitude, so a start that would overflow the residual is bad input.
-fn check_start(scene: &Scene, q: &[Complex64], label: &str) -> Result<()> {
+pub(super) fn check_start(scene: &Scene, q: &[Complex64], label: &str) -> Result<()> {
     let n = scene.model.n_dofs();
     let want = n * (scene.basis.harmonics() + 1);
     let bad = |reason: String| Error::InvalidOptions {

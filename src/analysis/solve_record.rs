@@ -14,6 +14,7 @@ impl SolveAnalysis {
         let basis = sol.basis();
         let order = |k| order_of(k, self.fundamental_order, basis.subharmonic());
         json!({
+            "schema_version": super::SCHEMA_VERSION,
             "converged": sol.is_converged(),
             "termination": sol.termination.to_string(),
             "method": self.method,

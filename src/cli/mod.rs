@@ -39,7 +39,9 @@ mod solve_files;
 mod solve_text;
 pub(crate) mod start;
 pub(crate) mod sweep;
+mod sweep_files;
 pub(crate) mod sweep_summary;
+mod sweep_text;
 
 /// An error with its exit code.
 pub(crate) struct Failure {
@@ -56,15 +58,9 @@ impl<E: Into<anyhow::Error>> From<E> for Failure {
     }
 }
 
-/// Exit code of a library error: 1 for a numerical failure (a non-finite value, a failed
-/// integration or solver), 2 for bad input.
+/// Exit code of a library error ([`hbal::Error::exit_code`]).
 pub(crate) fn exit_code(e: &hbal::Error) -> u8 {
-    match e {
-        hbal::Error::NonFinite { .. }
-        | hbal::Error::Solver { .. }
-        | hbal::Error::TimeIntegration { .. } => 1,
-        _ => 2,
-    }
+    e.exit_code()
 }
 
 /// A plot that cannot be drawn (nothing finite to show) is a warning on stderr: the
@@ -77,20 +73,6 @@ pub(crate) fn plot_warning(e: Box<dyn std::error::Error>) {
 pub(crate) fn failure(e: hbal::Error, file: &str) -> Failure {
     Failure {
         code: exit_code(&e),
-        error: anyhow::Error::new(e).context(file.to_string()),
-    }
-}
-
-/// A library error along a sweep whose input was checked at its first point: a singular
-/// dynamic stiffness or a failed solve further on is a numerical failure (exit 1); only a
-/// model too large to set up stays bad input (exit 2).
-pub(crate) fn sweep_failure(e: hbal::Error, file: &str) -> Failure {
-    let code = match e {
-        hbal::Error::TooLarge { .. } => 2,
-        _ => 1,
-    };
-    Failure {
-        code,
         error: anyhow::Error::new(e).context(file.to_string()),
     }
 }
@@ -253,19 +235,6 @@ pub(crate) fn multipliers_json(f: &Floquet) -> serde_json::Value {
         .iter()
         .map(|m| [m.re, m.im])
         .collect::<Vec<_>>())
-}
-
-/// Checks that every multiplier is finite (a non-finite one would print as JSON `null`); the
-/// library promises it, and the command line does not pass a broken promise on.
-pub(crate) fn check_finite(f: &Floquet) -> Result<(), String> {
-    if f.multipliers
-        .iter()
-        .all(|m| m.re.is_finite() && m.im.is_finite())
-    {
-        Ok(())
-    } else {
-        Err("non-finite Floquet multiplier".into())
-    }
 }
 
 /// `text` with its control characters (other than line breaks and tabs) written as `\u{1b}`

@@ -6,56 +6,12 @@
 //! default the first gear stage's transmission error, else the DOF that moves most) the order
 //! cuts `order_cuts.svg` and the waterfall of its spectrum over speed `waterfall.svg`.
 
+use hbal::analysis::Shown;
 use hbal::continuation::{Branch, BranchPoint};
-use hbal::report::{
-    line_plot, waterfall_plot, Axis, ElementOutput, ElementReport, Series, Slice, Waterfall,
-};
+use hbal::report::{line_plot, waterfall_plot, Axis, ElementOutput, Series, Slice, Waterfall};
 use hbal::scene::Scene;
-use hbal::{HarmonicBasis, Solution};
+use hbal::HarmonicBasis;
 use std::path::Path;
-
-/// The output the order-cut plot and the waterfall show.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Shown {
-    /// An element's coordinate (a gear stage's transmission error in µm or µrad).
-    Element(usize),
-    /// A DOF.
-    Dof(usize),
-    /// The DOF with the largest dynamic amplitude along the branch.
-    LargestDof,
-}
-
-/// The output named `name` (an element, else a DOF), or the default: the first gear stage,
-/// else the DOF that moves most. An unknown name is bad input that lists the names.
-pub(crate) fn choose(scene: &Scene, name: Option<&str>) -> anyhow::Result<Shown> {
-    let elements = scene.model.elements();
-    let Some(name) = name else {
-        return Ok(elements
-            .iter()
-            .position(|e| e.gear_stage().is_some())
-            .map_or(Shown::LargestDof, Shown::Element));
-    };
-    if let Some(i) = elements.iter().position(|e| e.name() == name) {
-        return Ok(Shown::Element(i));
-    }
-    if let Some(i) = scene.model.dof_names().iter().position(|d| d == name) {
-        return Ok(Shown::Dof(i));
-    }
-    let list = |names: Vec<&str>| {
-        let more = names.len().saturating_sub(12);
-        let mut s = names.into_iter().take(12).collect::<Vec<_>>().join(", ");
-        if more > 0 {
-            s.push_str(&format!(" and {more} more"));
-        }
-        s
-    };
-    Err(anyhow::anyhow!(
-        "{}: --output `{name}` is neither an element ({}) nor a DOF ({})",
-        scene.file,
-        list(elements.iter().map(|e| e.name()).collect()),
-        list(scene.model.dof_names().iter().map(String::as_str).collect()),
-    ))
-}
 
 /// What `shown` is on `branch`: a function from (point, its element outputs, harmonic k) to
 /// the amplitude, its name and unit.
@@ -259,90 +215,4 @@ pub(crate) fn write(
         .unwrap_or_else(super::plot_warning);
     }
     Ok(())
-}
-
-/// A speed range over which a contact opens for part of the period.
-#[derive(Debug, Clone, serde::Serialize)]
-pub(crate) struct ContactLoss {
-    pub(crate) element: String,
-    pub(crate) from: f64,
-    pub(crate) to: f64,
-    /// The largest fraction of the period it is open.
-    pub(crate) max_open: f64,
-}
-
-/// The ranges of consecutive points of `branch` where an element with an `open` state opens
-/// (more than 0.1 % of the period), in the speed unit of `speed`.
-pub(crate) fn contact_loss(
-    scene: &Scene,
-    branch: &Branch,
-    outputs: &[Vec<ElementOutput>],
-    speed: impl Fn(f64) -> f64,
-) -> Vec<ContactLoss> {
-    let has_open = |i: usize| {
-        scene.model.elements()[i]
-            .law()
-            .state_names()
-            .contains(&"open")
-    };
-    let contacts: Vec<usize> = (0..scene.model.elements().len())
-        .filter(|&i| has_open(i))
-        .collect();
-    let mut out = Vec::new();
-    if contacts.is_empty() {
-        return out;
-    }
-    let mut open: Vec<Option<ContactLoss>> = vec![None; contacts.len()];
-    for (p, outputs) in branch.points.iter().zip(outputs) {
-        let s = speed(p.omega);
-        for (slot, &i) in open.iter_mut().zip(&contacts) {
-            let fraction = outputs[i]
-                .states
-                .iter()
-                .find(|(n, _)| n == "open")
-                .map_or(0.0, |(_, f)| *f);
-            match (slot.as_mut(), fraction > 1e-3) {
-                (Some(run), true) => {
-                    run.from = run.from.min(s);
-                    run.to = run.to.max(s);
-                    run.max_open = run.max_open.max(fraction);
-                }
-                (None, true) => {
-                    *slot = Some(ContactLoss {
-                        element: outputs[i].name.clone(),
-                        from: s,
-                        to: s,
-                        max_open: fraction,
-                    })
-                }
-                (Some(_), false) => out.extend(slot.take()),
-                (None, false) => {}
-            }
-        }
-    }
-    out.extend(open.into_iter().flatten());
-    out
-}
-
-/// The element outputs of every point of `branch` (computed on `basis`), for the order cuts
-/// and the contact-loss ranges.
-pub(crate) fn point_outputs(
-    scene: &Scene,
-    branch: &Branch,
-    basis: &HarmonicBasis,
-) -> anyhow::Result<Vec<Vec<ElementOutput>>> {
-    let mut report = ElementReport::new(&scene.model);
-    branch
-        .points
-        .iter()
-        .map(|p| {
-            let sol = Solution::from_harmonics(
-                basis.with_omega(p.omega)?,
-                branch.dofs.clone(),
-                p.harmonics.clone(),
-                p.residual,
-            )?;
-            Ok(report.outputs(&sol)?)
-        })
-        .collect()
 }

@@ -19,7 +19,7 @@ pub(crate) struct ParameterSweep<'a> {
     pub(crate) stability: bool,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
-    /// `--dofs` ([`super::dof_selection`]).
+    /// `--dofs` ([`hbal::analysis::reported_dofs`]).
     pub(crate) dofs: Option<&'a str>,
 }
 
@@ -59,7 +59,7 @@ pub(crate) fn parameter_sweep(
         .map_err(|e| anyhow::anyhow!("{file}: --parameter {e}"))?;
     let mut probe = Scene::from_value(probe, &file)?;
     let first = basis_with(&probe.basis, opts.solver, &file)?;
-    let reported = super::dof_selection::reported_dofs(&probe.model, opts.dofs)?;
+    let reported = hbal::analysis::reported_dofs(&probe.model, opts.dofs)?;
     if let Some(dir) = out {
         for dof in probe.model.dof_names() {
             super::file_name_part(dof, "DOF")?;

@@ -67,9 +67,9 @@ impl Progress {
     }
 
     /// What the work does now (the bar's message; a plain line where stderr is no terminal).
-    pub(crate) fn message(&self, text: &'static str) {
+    pub(crate) fn message(&self, text: &str) {
         if let Some(bar) = &self.bar {
-            bar.set_message(text);
+            bar.set_message(text.to_string());
         }
         if let Some((what, _)) = &self.lines {
             eprintln!("progress: {what}: {text}");
@@ -81,5 +81,16 @@ impl Progress {
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
         }
+    }
+}
+
+/// The library's progress reports drive the bar.
+impl hbal::analysis::Observer for &Progress {
+    fn progress(&mut self, fraction: f64) {
+        self.set(fraction);
+    }
+
+    fn stage(&mut self, what: &str) {
+        self.message(what);
     }
 }

@@ -59,7 +59,7 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
         }
     }
-    super::order_cuts::choose(&scene, opts.output)?;
+    hbal::analysis::shown_output(&scene, opts.output)?;
     for dof in scene.model.dof_names() {
         super::file_name_part(dof, "DOF")?;
     }

@@ -1,67 +1,8 @@
-//! The branch of `hbal sweep` in words and JSON: one point as JSON (with every harmonic named
-//! by its index and its order of the reference shaft), a secondary branch as JSON, and the
-//! summary line of a secondary branch.
+//! The branch of `hbal sweep` in words: the lines on the orbits the multipliers belong to, a
+//! hint for long sweeps of large models, and the summary line of a secondary branch.
 
-use super::multipliers_json;
-use hbal::continuation::{Branch, BranchPoint};
+use hbal::continuation::Branch;
 use hbal::stability::Orbit;
-use serde_json::json;
-
-/// One point of a branch as JSON; harmonic k of a branch with period multiple ν is order
-/// `k · fundamental_order / ν` of the reference shaft (`shaft_order`; `order` is kept as it
-/// was: k, or k/ν on a period-multiplied branch). The harmonics of the DOFs `reported` only
-/// (the document's `harmonics_dofs`).
-pub(crate) fn point_json(
-    p: &BranchPoint,
-    branch: &Branch,
-    reported: &[usize],
-    fundamental_order: f64,
-    speed: impl Fn(f64) -> f64,
-) -> serde_json::Value {
-    let n = branch.dofs.len();
-    let nu = branch.subharmonic.max(1);
-    let f = p.floquet.as_ref();
-    json!({
-        "speed": speed(p.omega),
-        "omega_rad_s": p.omega,
-        "stable": p.stable(),
-        "fold": p.fold,
-        "fold_speed": if p.fold { p.fold_omega.map(&speed) } else { None },
-        "spurious_turn": p.spurious_turn,
-        "bifurcation": p.bifurcation.map(|b| format!("{b:?}")),
-        "bifurcation_speed": p.bifurcation_omega.map(&speed),
-        "residual": p.residual,
-        "truncation": p.truncation,
-        "error_estimate": p.error_estimate,
-        "error_estimate_harmonics": p.error_estimate_harmonics,
-        "worst_quantity": p.worst_quantity,
-        "quadrature": p.quadrature,
-        "max_abs": p.max_abs,
-        "multipliers": f.map(multipliers_json),
-        "multipliers_abs": f.map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
-        "neutral": f.map(|f| f.neutral),
-        "orbit_correction": f.map(|f| f.orbit_correction),
-        "polished": f.map(|f| f.polished),
-        "stability_orbit": f.map(|f| f.orbit),
-        "orbit_difference": f.and_then(|f| f.orbit_difference),
-        "orbit_distance": f.map(|f| f.orbit_distance),
-        "other_orbit": f.and_then(|f| f.other_orbit),
-        "turn_evidence": p.turn_evidence.map(|e| json!({
-            "before_speed": speed(e.before.0), "before_real_above_one": e.before.1,
-            "after_speed": speed(e.after.0), "after_real_above_one": e.after.1,
-            "turns": e.turns,
-        })),
-        "harmonics": reported.iter().filter(|&&i| i < n).map(|&i| (0..=branch.harmonics).map(|k| {
-            let (c, s) = hbal::harmonic::cos_sin(p.harmonics[k * n + i]);
-            let shaft_order = super::element_report::order_of(k, fundamental_order, nu);
-            if nu == 1 {
-                json!({"order": k, "harmonic": k, "shaft_order": shaft_order, "cos": c, "sin": s})
-            } else {
-                json!({"harmonic": k, "order": k as f64 / nu as f64, "shaft_order": shaft_order, "cos": c, "sin": s})
-            }
-        }).collect::<Vec<_>>()).collect::<Vec<_>>(),
-    })
-}
 
 /// The summary lines of the orbits the multipliers belong to: where the shooting found another
 /// periodic orbit than the point's (the HB orbit's own multipliers instead), and how many points have the HB orbit's multipliers ([`Orbit::Harmonic`]) with
@@ -133,29 +74,6 @@ pub(crate) fn orbit_hint(branch: &Branch) -> Option<String> {
         .count();
     (reduced >= 100).then(|| {
         "note: --stability-orbit harmonic gives each point the HB orbit's multipliers (where every law is piecewise affine: no orbit integrated, checked against the exact orbit's along the way); the 1000-DOF drivetrain's run-up took 5.0 s instead of 8.0 s".to_string()
-    })
-}
-
-/// A secondary branch as JSON: where it leaves the main branch, its period multiple, its
-/// points and why it ended.
-pub(crate) fn secondary_json(
-    b: &Branch,
-    reported: &[usize],
-    fundamental_order: f64,
-    speed: impl Fn(f64) -> f64 + Copy,
-) -> serde_json::Value {
-    let origin = b.origin.as_ref();
-    json!({
-        "bifurcation": origin.map(|o| format!("{:?}", o.bifurcation)),
-        "from_speed": origin.map(|o| speed(o.omega)),
-        "from_omega_rad_s": origin.map(|o| o.omega),
-        "side": origin.map(|o| o.side),
-        "parent_point": origin.map(|o| o.parent_point),
-        "period_multiple": b.subharmonic,
-        "stop": b.stop.to_string(),
-        "reached": b.stop.is_normal_end(),
-        "folds": b.folds(),
-        "points": b.points.iter().map(|p| point_json(p, b, reported, fundamental_order, speed)).collect::<Vec<_>>(),
     })
 }
 

@@ -335,6 +335,9 @@ impl Continuation {
                 return Some(BranchStop::StabilityFailed { omega, reason });
             }
             progress(((omega - from) / (to - from)).clamp(0.0, 1.0));
+            if self.cancel.is_cancelled() {
+                return Some(BranchStop::Cancelled { parameter: omega });
+            }
             if landed || (omega - to) * direction >= 0.0 {
                 return Some(BranchStop::Reached);
             }

@@ -32,7 +32,7 @@ impl Continuation {
     ) -> Result<Vec<Branch>> {
         let tracer = Continuation {
             error_estimate: true,
-            ..*self
+            ..self.clone()
         };
         let mut segments = Vec::new();
         let (mut basis, mut start) = (basis, initial.map(|q| q.to_vec()));

@@ -21,6 +21,7 @@
 mod arclength;
 mod auto_harmonics;
 mod bordered;
+mod cancel;
 mod locate;
 mod parameter;
 mod pipeline;
@@ -29,6 +30,7 @@ mod speed_homotopy;
 mod switch;
 mod time_invariant;
 
+pub use cancel::Cancel;
 pub use parameter::{parameter_sweep, sweep_values};
 pub use point::TurnEvidence;
 pub use speed_homotopy::{solve_robustly, solve_with_fallbacks};
@@ -176,6 +178,12 @@ pub enum BranchStop {
         /// The next segment's H.
         harmonics: usize,
     },
+    /// The caller cancelled the sweep ([`Continuation::cancel`]) after the point at this
+    /// parameter value (Ω for a frequency sweep): the points so far are kept.
+    Cancelled {
+        /// The last point's parameter.
+        parameter: f64,
+    },
 }
 
 impl std::fmt::Display for BranchStop {
@@ -210,6 +218,9 @@ impl std::fmt::Display for BranchStop {
             }
             BranchStop::Failed { parameter, reason } => {
                 write!(f, "failed at parameter {parameter}: {reason}")
+            }
+            BranchStop::Cancelled { parameter } => {
+                write!(f, "cancelled after the point at {parameter}")
             }
             BranchStop::NotConverged { parameter } => {
                 write!(
@@ -307,7 +318,7 @@ impl Branch {
 }
 
 /// Pseudo-arclength continuation in Ω.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Continuation {
     /// Solver of the first point (falls back to the others and a load homotopy). Default
     /// Newton with the corrector's tolerance.
@@ -347,6 +358,9 @@ pub struct Continuation {
     /// points ahead. Default 200 µs (below, handing points over costs about what it saves:
     /// the Duffing sweep's 50 µs per point were 6 % slower with a worker).
     pub stability_worker: Option<std::time::Duration>,
+    /// Checked after every point: once set, the sweep ends with [`BranchStop::Cancelled`].
+    /// Default: a token nobody can set.
+    pub cancel: Cancel,
 }
 
 impl Default for Continuation {
@@ -363,6 +377,7 @@ impl Default for Continuation {
             error_estimate: false,
             formulation: crate::Formulation::Auto,
             stability_worker: Some(std::time::Duration::from_micros(200)),
+            cancel: Cancel::default(),
         }
     }
 }

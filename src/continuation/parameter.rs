@@ -74,6 +74,10 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
                         break;
                     }
                     progress((i + 1) as f64 / values.len() as f64);
+                    if cont.cancel.is_cancelled() && i + 1 < values.len() {
+                        b.stop = BranchStop::Cancelled { parameter: p };
+                        break;
+                    }
                     continue;
                 }
                 Ok(None) => {}
@@ -175,6 +179,10 @@ pub fn sweep_values<M: std::borrow::Borrow<Model>>(
             break;
         }
         progress((i + 1) as f64 / values.len() as f64);
+        if cont.cancel.is_cancelled() && i + 1 < values.len() {
+            b.stop = BranchStop::Cancelled { parameter: p };
+            break;
+        }
     }
     branch.ok_or_else(|| Error::invalid("parameter sweep", "values", 0.0, "at least one value"))
 }

@@ -85,7 +85,7 @@ pub fn solve_robustly(
         stability: None,
         error_estimate: false,
         max_points: continuation.max_points.min(HOMOTOPY_POINTS),
-        ..*continuation
+        ..continuation.clone()
     };
     for factor in [0.5, 2.0, 0.25, 4.0] {
         let far = HarmonicBasis::new(omega * factor, basis.harmonics())?

@@ -54,6 +54,9 @@ impl Continuation {
     ) -> Result<Vec<Branch>> {
         let mut out: Vec<Branch> = Vec::new();
         for i in 1..parent.points.len() {
+            if self.cancel.is_cancelled() {
+                break;
+            }
             let kind = match parent.points[i].bifurcation {
                 Some(k @ (Bifurcation::BranchPoint | Bifurcation::PeriodDoubling)) => k,
                 _ => continue,

@@ -134,6 +134,12 @@ impl Continuation {
                 return Ok(Some(branch));
             }
             progress(((last.omega - from) / (to - from)).clamp(0.0, 1.0));
+            if self.cancel.is_cancelled() {
+                branch.stop = BranchStop::Cancelled {
+                    parameter: last.omega,
+                };
+                return Ok(Some(branch));
+            }
         }
         Ok(Some(branch))
     }

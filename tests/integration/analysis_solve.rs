@@ -3,44 +3,14 @@
 //! field, the serialised library result (wall times aside), and the exit code is the
 //! analysis's.
 
+use crate::common::json_diff::{first_difference, without_times};
 use hbal::analysis::{solve, SolveSettings};
 use hbal::scene::Scene;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
-/// `value` without the wall times (keys ending in `seconds`), which differ between runs.
-fn without_times(value: &mut Value) {
-    match value {
-        Value::Object(map) => {
-            map.retain(|k, _| !k.ends_with("seconds"));
-            map.values_mut().for_each(without_times);
-        }
-        Value::Array(items) => items.iter_mut().for_each(without_times),
-        _ => {}
-    }
-}
-
-/// The first path where `a` and `b` differ, with both values.
-fn first_difference(a: &Value, b: &Value, path: &str) -> Option<String> {
-    match (a, b) {
-        (Value::Object(x), Value::Object(y)) => {
-            if x.keys().ne(y.keys()) {
-                return Some(format!("{path}: keys {:?} vs {:?}", x.keys(), y.keys()));
-            }
-            x.iter()
-                .find_map(|(k, v)| first_difference(v, &y[k], &format!("{path}.{k}")))
-        }
-        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
-            .iter()
-            .zip(y)
-            .enumerate()
-            .find_map(|(i, (v, w))| first_difference(v, w, &format!("{path}[{i}]"))),
-        _ if a == b => None,
-        _ => Some(format!("{path}: {a} vs {b}")),
-    }
-}
-
-fn scenes() -> Vec<PathBuf> {
+/// Every example scene (TOML), sorted.
+pub(crate) fn scenes() -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()

@@ -11,6 +11,7 @@ mod common;
 mod accuracy_estimate;
 mod aft;
 mod analysis_solve;
+mod analysis_sweep;
 mod bad_input;
 mod band_limited;
 mod branch_switching;

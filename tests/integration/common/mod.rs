@@ -7,6 +7,7 @@ pub mod cli;
 pub mod floquet;
 pub mod galerkin;
 pub mod hostile;
+pub mod json_diff;
 pub mod time_domain;
 
 use num_complex::Complex64;

@@ -1,0 +1,47 @@
+//! The files of `hbal sweep --out DIR`: branch.csv (and branch_1.csv, ... of the switched
+//! branches), the order cuts ([`super::order_cuts`]) and one frequency-response SVG per
+//! reported DOF with every branch.
+
+use hbal::analysis::SweepAnalysis;
+use hbal::continuation::{Branch, BranchStop};
+use hbal::scene::Scene;
+use std::path::Path;
+
+/// Writes the files of `a` (a sweep of `scene`) into `dir`.
+pub(crate) fn write(dir: &Path, scene: &Scene, a: &SweepAnalysis) -> anyhow::Result<()> {
+    let speed = |w: f64| a.speed(w);
+    let csv = |b: &Branch| {
+        hbal::report::branch_csv_of_dofs(b, a.fundamental_order, &a.reported, &a.unit, speed)
+    };
+    std::fs::create_dir_all(dir)?;
+    std::fs::write(dir.join("branch.csv"), csv(&a.branch))?;
+    let shows = super::order_cuts::Shows {
+        dofs: &a.reported,
+        plotted: a.shown,
+    };
+    super::order_cuts::write(dir, scene, &a.branch, &a.basis, &a.outputs, shows, speed)?;
+    for (i, b) in a.secondary.iter().enumerate() {
+        std::fs::write(dir.join(format!("branch_{}.csv", i + 1)), csv(b))?;
+    }
+    if a.branch.points.len() < 2 {
+        return Ok(());
+    }
+    let all: Vec<&Branch> = std::iter::once(&a.branch).chain(&a.secondary).collect();
+    let stopped = match a.branch.stop {
+        BranchStop::Reached => String::new(),
+        ref stop => format!(" - STOPPED: {stop}"),
+    };
+    for &i in &a.reported {
+        let dof = &a.branch.dofs[i];
+        hbal::report::branches_plot(
+            &dir.join(format!("frequency_response_{dof}.svg")),
+            &all,
+            i,
+            &format!("Frequency response of {dof}: {}{stopped}", a.file),
+            &format!("speed ({})", a.unit),
+            speed,
+        )
+        .unwrap_or_else(super::plot_warning);
+    }
+    Ok(())
+}
