@@ -45,9 +45,9 @@ pub struct SweepSettings {
     pub formulation: Formulation,
     /// The corrector's relative residual tolerance (default the continuation's, 1e-10).
     pub tolerance: Option<f64>,
-    /// The element or DOF the order-cut plot shows ([`shown_output`]).
+    /// The element or DOF the order-cut plot shows ([`shown_output`](super::shown_output)).
     pub output: Option<String>,
-    /// The DOFs reported in full ([`reported_dofs`]).
+    /// The DOFs reported in full ([`reported_dofs`](super::reported_dofs)).
     pub dofs: Option<String>,
     /// Set from outside to stop after the current point (the points so far are kept).
     pub cancel: Cancel,
