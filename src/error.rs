@@ -169,6 +169,9 @@ pub enum Error {
     /// inner error's kind ([`Error::exit_code`]).
     #[error(transparent)]
     AfterCheck(Box<Error>),
+    /// A scene that cannot be read or does not follow the schema (bad input).
+    #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
 }
 
 impl Error {

@@ -36,6 +36,7 @@ mod element_record;
 mod observer;
 mod options;
 mod output_choice;
+mod parameter_sweep;
 mod solve;
 mod solve_record;
 mod sweep;
@@ -48,6 +49,9 @@ pub use element_record::order_of;
 pub use observer::{Observer, Silent};
 pub use options::{check, check_speed, check_sweep_start};
 pub use output_choice::{reported_dofs, shown_output, Shown, ALL_DOFS_UP_TO};
+pub use parameter_sweep::{
+    parameter_sweep, ParameterAuto, ParameterSweepAnalysis, ParameterSweepSettings,
+};
 pub use solve::{solve, AutoRecord, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};
 pub use sweep::{sweep, SweepAnalysis};
 pub use sweep_outcome::SweepNote;

@@ -5,9 +5,7 @@
 
 use anyhow::Context;
 use hbal::scene::Scene;
-use hbal::stability::Floquet;
 use hbal::{HarmonicBasis, Method};
-use serde_json::json;
 use std::path::Path;
 
 /// `println!` that ends the process quietly when stdout is closed (`hbal ... | head`).
@@ -71,9 +69,17 @@ pub(crate) fn plot_warning(e: Box<dyn std::error::Error>) {
 
 /// A library error with the scene's name and its exit code ([`exit_code`]).
 pub(crate) fn failure(e: hbal::Error, file: &str) -> Failure {
+    let code = exit_code(&e);
+    // A scene error names its file already.
+    let named = matches!(&e, hbal::Error::Scene(s) if s.file == file);
+    let error = anyhow::Error::new(e);
     Failure {
-        code: exit_code(&e),
-        error: anyhow::Error::new(e).context(file.to_string()),
+        code,
+        error: if named {
+            error
+        } else {
+            error.context(file.to_string())
+        },
     }
 }
 
@@ -90,7 +96,7 @@ pub(crate) struct SolverArgs {
     /// range, peak values included; the default), `auto:solution` that of the periodic
     /// solution as a whole with the harmonics it lacks.
     #[arg(long)]
-    pub(crate) harmonics: Option<HarmonicsArg>,
+    pub(crate) harmonics: Option<hbal::scene::HarmonicsOverride>,
     /// Number of time samples N per period, at least 2H+1 (default: the scene's, or the
     /// default for --harmonics).
     #[arg(long)]
@@ -104,59 +110,24 @@ pub(crate) struct SolverArgs {
     pub(crate) formulation: hbal::Formulation,
 }
 
-/// `--harmonics`: a number, or `auto` (with what it controls, else the scene's choice).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum HarmonicsArg {
-    Auto(Option<hbal::solve::Control>),
-    Count(usize),
-}
-
-impl std::str::FromStr for HarmonicsArg {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        use hbal::solve::Control;
-        match s {
-            "auto" => return Ok(HarmonicsArg::Auto(None)),
-            "auto:solution" => return Ok(HarmonicsArg::Auto(Some(Control::Solution))),
-            "auto:harmonics" => return Ok(HarmonicsArg::Auto(Some(Control::Harmonics))),
-            "auto:quantities" => return Ok(HarmonicsArg::Auto(Some(Control::Quantities))),
-            _ => {}
-        }
-        s.parse::<usize>().map(HarmonicsArg::Count).map_err(|_| {
-            format!(
-                "expected a whole number of harmonics, `auto`, `auto:harmonics`, `auto:quantities` or `auto:solution`, got `{s}`"
-            )
-        })
-    }
-}
-
 impl SolverArgs {
+    /// The library's overrides of these flags.
+    pub(crate) fn overrides(&self) -> hbal::scene::Overrides {
+        hbal::scene::Overrides {
+            method: self.method.clone(),
+            harmonics: self.harmonics,
+            samples: self.samples,
+            tolerance: self.tolerance,
+            formulation: self.formulation,
+        }
+    }
+
     /// The scene's solver settings applied to method `name`, with `--tolerance`.
     pub(crate) fn method_named(&self, scene: &Scene, name: &str) -> Result<Method, Failure> {
         let method = scene.method_named(name)?;
-        self.with_tolerance(method, &scene.file)
-    }
-
-    fn with_tolerance(&self, method: Method, file: &str) -> Result<Method, Failure> {
-        let Some(t) = self.tolerance else {
-            return Ok(method);
-        };
-        let context = || format!("{file}: --tolerance");
-        hbal::scene::check_tolerance(t).map_err(|m| anyhow::anyhow!("{}: {m}", context()))?;
-        Ok(match method {
-            Method::FixedPoint(o) => Method::FixedPoint(o.with_tolerance(t).with_context(context)?),
-            Method::Newton(o) => Method::Newton(o.with_tolerance(t).with_context(context)?),
-            Method::Broyden(o) => Method::Broyden(o.with_tolerance(t).with_context(context)?),
-            Method::Anderson(o) => Method::Anderson(o.with_tolerance(t).with_context(context)?),
-            // Exact: no residual tolerance to meet (a scene's `tolerance` is refused too).
-            Method::PiecewiseExact(_) => {
-                return Err(anyhow::anyhow!(
-                    "{}: method piecewise_exact has no residual tolerance (its harmonics are exact to rounding); drop --tolerance",
-                    context()
-                )
-                .into())
-            }
-        })
+        self.overrides()
+            .with_tolerance(method)
+            .map_err(|e| failure(e, &scene.file))
     }
 }
 
@@ -166,75 +137,10 @@ pub(crate) fn load(path: &Path, args: &SolverArgs) -> Result<Scene, Failure> {
     for note in &scene.notes {
         eprintln!("note: {}: {note}", scene.file);
     }
-    if let Some(name) = &args.method {
-        scene.method = scene.method_named(name)?;
-    }
-    scene.method = args.with_tolerance(scene.method, &scene.file)?;
-    scene.basis = basis_with(&scene.basis, args, &scene.file)?;
-    auto_with(&mut scene.auto, args);
+    args.overrides()
+        .apply(&mut scene)
+        .map_err(|e| failure(e, &scene.file))?;
     Ok(scene)
-}
-
-/// The scene's automatic harmonics with `--harmonics` (`auto[:control]` turns them on, a count
-/// off) and `--formulation` applied.
-pub(crate) fn auto_with(auto: &mut Option<hbal::solve::AutoHarmonics>, args: &SolverArgs) {
-    if let Some(a) = auto.as_mut() {
-        a.formulation = args.formulation;
-    }
-    match args.harmonics {
-        Some(HarmonicsArg::Auto(control)) => {
-            let a = auto.unwrap_or_default();
-            *auto = Some(hbal::solve::AutoHarmonics {
-                formulation: args.formulation,
-                control: control.unwrap_or(a.control),
-                ..a
-            })
-        }
-        Some(HarmonicsArg::Count(_)) => *auto = None,
-        None => {}
-    }
-}
-
-/// The basis of `H`, `N` and tail correction of `chosen` (automatic harmonics at another
-/// speed or parameter) at the speed of `basis`.
-pub(crate) fn basis_like(
-    basis: &HarmonicBasis,
-    chosen: &HarmonicBasis,
-) -> hbal::Result<HarmonicBasis> {
-    HarmonicBasis::new(basis.omega(), chosen.harmonics())?
-        .with_tail_correction_of(chosen)
-        .with_samples(chosen.samples())
-}
-
-/// `basis` with `--harmonics` and `--samples` applied.
-pub(crate) fn basis_with(
-    basis: &HarmonicBasis,
-    args: &SolverArgs,
-    file: &str,
-) -> Result<HarmonicBasis, Failure> {
-    let mut out = *basis;
-    if let Some(HarmonicsArg::Count(h)) = args.harmonics {
-        let b = HarmonicBasis::new(basis.omega(), h)
-            .with_context(|| format!("{file}: --harmonics"))?
-            .with_tail_correction_of(basis);
-        // Keep the scene's N where it can still carry H harmonics.
-        out = b.with_samples(basis.samples()).unwrap_or(b);
-    }
-    if let Some(n) = args.samples {
-        out = out
-            .with_samples(n)
-            .with_context(|| format!("{file}: --samples"))?;
-    }
-    Ok(out)
-}
-
-/// Multipliers as `[[re, im], ...]`.
-pub(crate) fn multipliers_json(f: &Floquet) -> serde_json::Value {
-    json!(f
-        .multipliers
-        .iter()
-        .map(|m| [m.re, m.im])
-        .collect::<Vec<_>>())
 }
 
 /// `text` with its control characters (other than line breaks and tabs) written as `\u{1b}`

@@ -37,9 +37,11 @@ mod harmonics;
 mod loads;
 mod matrix;
 pub mod matrix_market;
+mod overrides;
 mod paths;
 mod solver;
 
+pub use overrides::{HarmonicsOverride, Overrides};
 use paths::{field_path, is_json, line_col, non_finite, out_of_range, strip_position};
 use solver::SolverSpec;
 pub use solver::{check_tolerance, MAX_ITERATIONS, METHODS, MIN_TOLERANCE};

@@ -180,3 +180,76 @@ fn the_library_refuses_invalid_sweep_options() {
         assert_eq!(e.exit_code(), 2, "{e}");
     }
 }
+
+/// The parameter sweep: the library's result is `hbal sweep --parameter --json`; a field that
+/// changes the model's DOFs is bad input before any work; a cancelled sweep keeps its points.
+#[test]
+fn the_parameter_sweep_runs_in_the_library() {
+    use hbal::analysis::{parameter_sweep, ParameterSweepSettings};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/duffing.toml");
+    let file = path.display().to_string();
+    let doc = Scene::parse_value(&std::fs::read_to_string(&path).unwrap(), &file).unwrap();
+    let settings = ParameterSweepSettings {
+        parameter: "loads[0].cos".into(),
+        from: 0.02,
+        to: 0.1,
+        points: 6,
+        stability: true,
+        overrides: Default::default(),
+        dofs: None,
+        cancel: Cancel::default(),
+    };
+    let a = parameter_sweep(&doc, &file, &settings, &mut Silent).unwrap();
+    assert_eq!(a.branch.points.len(), 6);
+    assert_eq!(a.exit_code(), 0);
+    let mut library: Value = serde_json::from_str(&serde_json::to_string(&a).unwrap()).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args(["sweep", "--json", "--parameter", "loads[0].cos"])
+        .args(["--from", "0.02", "--to", "0.1", "--points", "6"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let mut cli: Value = serde_json::from_slice(&out.stdout).unwrap();
+    without_times(&mut library);
+    without_times(&mut cli);
+    assert_eq!(first_difference(&library, &cli, ""), None);
+    assert_eq!(cli["schema_version"], 1);
+    // The response grows with the load.
+    let m: Vec<f64> = a.branch.points.iter().map(|p| p.max_abs[0]).collect();
+    assert!(m.windows(2).all(|w| w[1] > w[0]), "{m:?}");
+
+    let dofs = ParameterSweepSettings {
+        parameter: "dofs.count".into(),
+        ..settings.clone()
+    };
+    let e = parameter_sweep(&doc, &file, &dofs, &mut Silent).unwrap_err();
+    assert!(e.to_string().contains("changes the model's DOFs"), "{e}");
+    assert_eq!(e.exit_code(), 2);
+    let method = ParameterSweepSettings {
+        overrides: hbal::scene::Overrides {
+            method: Some("newton".into()),
+            ..Default::default()
+        },
+        ..settings.clone()
+    };
+    let e = parameter_sweep(&doc, &file, &method, &mut Silent).unwrap_err();
+    assert!(
+        e.to_string().contains("--method applies to speed sweeps"),
+        "{e}"
+    );
+
+    let cancel = Cancel::new();
+    let mut observer = CancelAfter {
+        fractions: Vec::new(),
+        cancel: cancel.clone(),
+    };
+    let cancelled = ParameterSweepSettings { cancel, ..settings };
+    let c = parameter_sweep(&doc, &file, &cancelled, &mut observer).unwrap();
+    assert_eq!(c.branch.points.len(), 3);
+    assert!(
+        matches!(c.branch.stop, BranchStop::Cancelled { .. }),
+        "{}",
+        c.branch.stop
+    );
+    assert_eq!(c.exit_code(), 1);
+}

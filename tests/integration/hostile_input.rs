@@ -263,7 +263,7 @@ fn meaningless_fields_are_refused_with_their_path() {
         &duffing,
         &["solve", "{}", "--tolerance", "0"],
         2,
-        "--tolerance: must be in [1e-15, 1)",
+        "--tolerance must be in [1e-15, 1)",
     );
     // A negative value is a value, not an unknown option: the sweep's own check answers.
     expect(
