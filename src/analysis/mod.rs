@@ -32,6 +32,7 @@
 //! ```
 
 mod branch_outputs;
+mod compare;
 mod element_record;
 mod observer;
 mod options;
@@ -45,6 +46,7 @@ mod sweep_record;
 mod sweep_settings;
 
 pub use branch_outputs::{contact_loss, point_outputs, ContactLoss};
+pub use compare::{compare, CompareAnalysis, CompareAuto, CompareSettings, MethodComparison};
 pub use element_record::order_of;
 pub use observer::{Observer, Silent};
 pub use options::{check, check_speed, check_sweep_start};

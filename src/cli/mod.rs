@@ -5,7 +5,7 @@
 
 use anyhow::Context;
 use hbal::scene::Scene;
-use hbal::{HarmonicBasis, Method};
+use hbal::HarmonicBasis;
 use std::path::Path;
 
 /// `println!` that ends the process quietly when stdout is closed (`hbal ... | head`).
@@ -120,14 +120,6 @@ impl SolverArgs {
             tolerance: self.tolerance,
             formulation: self.formulation,
         }
-    }
-
-    /// The scene's solver settings applied to method `name`, with `--tolerance`.
-    pub(crate) fn method_named(&self, scene: &Scene, name: &str) -> Result<Method, Failure> {
-        let method = scene.method_named(name)?;
-        self.overrides()
-            .with_tolerance(method)
-            .map_err(|e| failure(e, &scene.file))
     }
 }
 

@@ -1,23 +1,8 @@
 //! The per-quantity error estimate as the CLI prints it: the worst DOF or element coordinate
 //! and the worst element force, each by name and relative to its own range.
 
-use hbal::compare::QuantityError;
 use hbal::solve::ErrorEstimate;
 use hbal::Model;
-use serde_json::{json, Value};
-
-/// `{"name", "quantity", "error", "range"}` of one quantity, or null.
-pub(crate) fn quantity_json(model: &Model, q: Option<QuantityError>) -> Value {
-    match q {
-        Some(q) => json!({
-            "name": q.quantity.name(model),
-            "quantity": q.quantity,
-            "error": q.error,
-            "range": q.range,
-        }),
-        None => Value::Null,
-    }
-}
 
 /// `"; worst quantity u(mesh) 1.8e-2 of its range 4.1e-5, force f(mesh) 2.2e-2"`, or
 /// nothing where the quantities were not estimated; with `"; contact quadrature 3.1e-8 of
