@@ -34,6 +34,7 @@
 mod branch_outputs;
 mod compare;
 mod element_record;
+mod modes;
 mod observer;
 mod options;
 mod output_choice;
@@ -48,6 +49,7 @@ mod sweep_settings;
 pub use branch_outputs::{contact_loss, point_outputs, ContactLoss};
 pub use compare::{compare, CompareAnalysis, CompareAuto, CompareSettings, MethodComparison};
 pub use element_record::order_of;
+pub use modes::{excitation_orders, modes, CriticalSpeed, ModesAnalysis, ModesSettings};
 pub use observer::{Observer, Silent};
 pub use options::{check, check_speed, check_sweep_start};
 pub use output_choice::{reported_dofs, shown_output, Shown, ALL_DOFS_UP_TO};

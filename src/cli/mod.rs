@@ -5,7 +5,6 @@
 
 use anyhow::Context;
 use hbal::scene::Scene;
-use hbal::HarmonicBasis;
 use std::path::Path;
 
 /// `println!` that ends the process quietly when stdout is closed (`hbal ... | head`).
@@ -172,34 +171,6 @@ pub(crate) fn speed_text(v: f64) -> String {
     } else {
         s
     }
-}
-
-/// The excitation orders (multiples of the reference speed) and their harmonic index on
-/// `basis`, where they are harmonics of it.
-pub(crate) fn excitation_orders(
-    scene: &hbal::scene::Scene,
-    basis: &HarmonicBasis,
-) -> Vec<(f64, usize)> {
-    let f = scene.fundamental_order / basis.subharmonic() as f64;
-    let mut ks: Vec<usize> = scene
-        .model
-        .loads()
-        .iter()
-        .filter(|l| l.order > 0)
-        .map(|l| l.order * basis.subharmonic())
-        .chain(
-            scene
-                .model
-                .elements()
-                .iter()
-                .filter_map(|e| e.law().time_order())
-                .map(|z| z * basis.subharmonic()),
-        )
-        .filter(|&k| k <= basis.harmonics())
-        .collect();
-    ks.sort_unstable();
-    ks.dedup();
-    ks.into_iter().map(|k| (k as f64 * f, k)).collect()
 }
 
 /// Where a subcommand's JSON document goes when it is kept instead of printed: `hbal report`

@@ -1,13 +1,13 @@
-//! `hbal modes`: natural frequencies and mode shapes of a scene linearised about its periodic
-//! solution (with the one- and two-tooth bounds of time-varying meshes), the excitation orders
-//! and the critical speeds where they cross; a Campbell diagram and `modes.csv` with `--out`.
+//! `hbal modes`: runs the library's modes analysis ([`hbal::analysis::modes`]: natural
+//! frequencies and mode shapes about the periodic solution, with the one- and two-tooth
+//! bounds of time-varying meshes, the excitation orders and the critical speeds) and renders
+//! it as a table or JSON; a Campbell diagram and `modes.csv` with `--out`.
 
 use super::{load, Failure, SolverArgs};
 use anyhow::Context;
-use hbal::report::{line_plot, natural_frequencies, Axis, Series};
+use hbal::analysis::{ModesAnalysis, ModesSettings};
+use hbal::report::{line_plot, Axis, NaturalFrequencies, Series};
 use hbal::scene::Scene;
-use hbal::HarmonicBalance;
-use serde_json::json;
 use std::f64::consts::TAU;
 use std::path::Path;
 
@@ -28,138 +28,37 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     if let Some(dir) = opts.out {
         super::prepare_out(dir)?;
     }
-    let speed = scene.basis.omega() / scene.omega_per_speed;
-    let (from, to) = (opts.from.unwrap_or(0.0), opts.to.unwrap_or(2.0 * speed));
-    hbal::analysis::check_speed(&scene, "--from", from, true)
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
-    hbal::analysis::check_speed(&scene, "--to", to, false).map_err(|e| anyhow::anyhow!("{e}"))?;
-    if to <= from {
-        return Err(anyhow::anyhow!(
-            "--from {from} --to {to}: need 0 <= from < to (in {})",
-            scene.speed_unit
-        )
-        .into());
-    }
-    let max_hz = match opts.max_hz {
-        Some(f) if !(f.is_finite() && f > 0.0) => {
-            return Err(anyhow::anyhow!("--max-hz must be finite and > 0, got {f}").into())
-        }
-        Some(f) => f,
-        None if scene.model.n_dofs() <= 300 => f64::INFINITY,
-        None => 5000.0,
+    let settings = ModesSettings {
+        from: opts.from,
+        to: opts.to,
+        max_hz: opts.max_hz,
+        formulation: args.formulation,
     };
-    // The operating point: the periodic solution at the scene's speed.
-    let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, args.formulation)
-        .with_context(|| scene.file.clone())?;
-    let sol = scene
-        .method
-        .solve(&hb, None, &mut hb.workspace())
-        .map_err(|e| super::failure(e, &scene.file))?;
-    if !sol.is_converged() {
+    let a = hbal::analysis::modes(&scene, &settings).map_err(|e| super::failure(e, &scene.file))?;
+    let Some(nf) = &a.natural else {
         if opts.json && opts.capture.is_none() {
             // The document still comes, marked: what failed instead of the modes (the
             // report says it in its page instead).
-            super::emit(
-                json!({
-                    "scene": scene.file,
-                    "unit": scene.speed_unit,
-                    "operating_speed": speed,
-                    "converged": false,
-                    "termination": sol.termination.to_string(),
-                    "error": "the operating point did not converge: no linearisation",
-                    "modes": [],
-                    "critical_speeds": [],
-                }),
-                opts.capture,
-            );
+            super::emit(a.to_json(), opts.capture);
         }
         return Err(Failure {
             code: 1,
             error: anyhow::anyhow!(
                 "{}: the operating point did not converge ({}): no linearisation",
-                scene.file,
-                sol.termination
+                a.file,
+                a.termination
             ),
         });
-    }
-    let nf = natural_frequencies(&scene.model, &sol, max_hz)
-        .map_err(|e| super::failure(e, &scene.file))?;
-    let orders: Vec<f64> = super::excitation_orders(&scene, &scene.basis)
-        .into_iter()
-        .map(|(o, _)| o)
-        .collect();
-    // rad/s of the reference shaft per unit of speed.
-    let per_unit = scene.omega_per_speed / scene.fundamental_order;
-    let critical: Vec<(f64, usize, f64)> = orders
-        .iter()
-        .flat_map(|&o| {
-            nf.mean
-                .iter()
-                .enumerate()
-                .filter(|(_, f)| **f > 0.0)
-                .map(move |(i, &f)| (o, i, TAU * f / (o * per_unit)))
-        })
-        .filter(|&(_, _, s)| s >= from && s <= to)
-        .collect();
-    let unit = scene.speed_unit;
+    };
     if as_json {
-        let doc = json!({
-            "scene": scene.file,
-            "unit": unit,
-            "operating_speed": speed,
-            "converged": true,
-            "rigid_modes": nf.rigid,
-            "modes": nf.mean.iter().enumerate().map(|(i, f)| json!({
-                "mean_hz": f,
-                "lower_hz": nf.lower.get(i),
-                "upper_hz": nf.upper.get(i),
-                "shape": nf.shapes.column(i).iter().collect::<Vec<_>>(),
-            })).collect::<Vec<_>>(),
-            "dofs": scene.model.dof_names(),
-            "orders": orders,
-            "critical_speeds": critical.iter().map(|(o, i, s)| json!({
-                "order": o, "mode": i + 1, "speed": s,
-            })).collect::<Vec<_>>(),
-        });
-        super::emit(doc, opts.capture);
+        super::emit(a.to_json(), opts.capture);
     } else {
-        say!(
-            "{}: {} modes up to {} ({} rigid), linearised on the orbit at {speed} {unit}",
-            scene.file,
-            nf.mean.len(),
-            if max_hz.is_finite() {
-                format!("{max_hz} Hz")
-            } else {
-                "the highest".into()
-            },
-            nf.rigid
-        );
-        say!("  mode   mean Hz    one-tooth Hz   two-tooth Hz   largest DOF");
-        for (i, f) in nf.mean.iter().enumerate() {
-            let shape = nf.shapes.column(i);
-            let top = shape.iamax();
-            say!(
-                "  {:>4}  {:>11.4}  {:>11.4}    {:>11.4}     {}",
-                i + 1,
-                f,
-                nf.lower.get(i).copied().unwrap_or(f64::NAN),
-                nf.upper.get(i).copied().unwrap_or(f64::NAN),
-                scene.model.dof_names()[top]
-            );
-        }
-        let list: Vec<String> = orders.iter().map(|o| format!("{o}")).collect();
-        say!("  excitation orders: {}", list.join(", "));
-        for (o, i, s) in &critical {
-            say!(
-                "  critical speed {s:.2} {unit}: order {o} meets mode {}",
-                i + 1
-            );
-        }
+        table(&a, nf);
     }
     if let Some(dir) = opts.out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--out: cannot create {}", dir.display()))?;
-        write_outputs(dir, &scene, &nf, &orders, (from, to), per_unit)?;
+        write_outputs(dir, &scene, nf, &a.orders, a.range, a.per_unit)?;
         if !as_json {
             say!("  wrote modes.csv, campbell.svg to {}", dir.display());
         }
@@ -167,11 +66,51 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     Ok(0)
 }
 
+/// The table of modes, the excitation orders and the critical speeds.
+fn table(a: &ModesAnalysis, nf: &NaturalFrequencies) {
+    let limit = if a.max_hz.is_finite() {
+        format!("{} Hz", a.max_hz)
+    } else {
+        "the highest".into()
+    };
+    say!(
+        "{}: {} modes up to {limit} ({} rigid), linearised on the orbit at {} {}",
+        a.file,
+        nf.mean.len(),
+        nf.rigid,
+        a.operating_speed,
+        a.unit
+    );
+    say!("  mode   mean Hz    one-tooth Hz   two-tooth Hz   largest DOF");
+    for (i, f) in nf.mean.iter().enumerate() {
+        let top = nf.shapes.column(i).iamax();
+        say!(
+            "  {:>4}  {:>11.4}  {:>11.4}    {:>11.4}     {}",
+            i + 1,
+            f,
+            nf.lower.get(i).copied().unwrap_or(f64::NAN),
+            nf.upper.get(i).copied().unwrap_or(f64::NAN),
+            a.dofs[top]
+        );
+    }
+    let list: Vec<String> = a.orders.iter().map(|o| format!("{o}")).collect();
+    say!("  excitation orders: {}", list.join(", "));
+    for c in &a.critical {
+        say!(
+            "  critical speed {:.2} {}: order {} meets mode {}",
+            c.speed,
+            a.unit,
+            c.order,
+            c.mode
+        );
+    }
+}
+
 /// `modes.csv` (frequencies and shapes) and `campbell.svg`.
 fn write_outputs(
     dir: &Path,
     scene: &Scene,
-    nf: &hbal::report::NaturalFrequencies,
+    nf: &NaturalFrequencies,
     orders: &[f64],
     (from, to): (f64, f64),
     per_unit: f64,

@@ -106,7 +106,7 @@ pub(crate) fn write(
         dofs,
         plotted: shown,
     } = shows;
-    let orders = super::excitation_orders(scene, basis);
+    let orders = hbal::analysis::excitation_orders(scene, basis);
     let n = branch.dofs.len();
     let mut w = csv::Writer::from_path(dir.join("order_cuts.csv"))?;
     let mut header = vec![scene.speed_unit.to_string()];

@@ -11,6 +11,7 @@ mod common;
 mod accuracy_estimate;
 mod aft;
 mod analysis_compare;
+mod analysis_modes;
 mod analysis_solve;
 mod analysis_sweep;
 mod bad_input;

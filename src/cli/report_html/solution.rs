@@ -111,7 +111,7 @@ pub(super) fn solve_section(r: &mut HtmlReport, i: &Inputs) {
 }
 
 fn dof_table(r: &mut HtmlReport, i: &Inputs, doc: &Value) {
-    let orders: Vec<f64> = crate::cli::excitation_orders(i.scene, &i.scene.basis)
+    let orders: Vec<f64> = hbal::analysis::excitation_orders(i.scene, &i.scene.basis)
         .into_iter()
         .map(|o| o.0)
         .collect();

@@ -1,0 +1,221 @@
+//! Natural frequencies and mode shapes of a scene linearised about its periodic solution
+//! ([`modes()`], `hbal modes`): with the one- and two-tooth bounds of time-varying meshes, the
+//! excitation orders and the critical speeds where an order line `f = o · n` meets a natural
+//! frequency in the speed range.
+
+use crate::report::{natural_frequencies, NaturalFrequencies};
+use crate::scene::Scene;
+use crate::{Error, Formulation, HarmonicBalance, HarmonicBasis, Result, Termination};
+use serde_json::{json, Value};
+use std::f64::consts::TAU;
+
+/// What `hbal modes` computes besides the scene.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ModesSettings {
+    /// The lowest speed of the critical-speed range (the scene's unit; default 0).
+    pub from: Option<f64>,
+    /// The highest speed (default twice the scene's speed).
+    pub to: Option<f64>,
+    /// Modes up to this frequency (Hz; default every mode up to 300 DOFs, else 5000 Hz).
+    pub max_hz: Option<f64>,
+    /// The formulation of the operating point's harmonic balance.
+    pub formulation: Formulation,
+}
+
+/// Where an excitation order meets a natural frequency.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct CriticalSpeed {
+    /// The order of the reference speed.
+    pub order: f64,
+    /// The mode, from 1.
+    pub mode: usize,
+    /// The speed (the scene's unit).
+    pub speed: f64,
+}
+
+/// Everything `hbal modes` reports.
+#[derive(Debug, Clone)]
+pub struct ModesAnalysis {
+    /// The scene's file.
+    pub file: String,
+    /// The scene's speed unit.
+    pub unit: String,
+    /// The scene's speed, where the model is linearised.
+    pub operating_speed: f64,
+    /// The critical-speed range (the scene's unit).
+    pub range: (f64, f64),
+    /// The frequency limit (Hz; infinite for every mode).
+    pub max_hz: f64,
+    /// How the operating point's solve ended.
+    pub termination: Termination,
+    /// The natural frequencies; `None` where the operating point did not converge.
+    pub natural: Option<NaturalFrequencies>,
+    /// The excitation orders of the reference speed.
+    pub orders: Vec<f64>,
+    /// The critical speeds in the range, by order and mode.
+    pub critical: Vec<CriticalSpeed>,
+    /// The DOF names (the rows of the shapes).
+    pub dofs: Vec<String>,
+    /// rad/s of the reference shaft per unit of speed.
+    pub per_unit: f64,
+}
+
+/// The excitation orders (multiples of the reference speed) of `scene` and their harmonic
+/// index on `basis`, where they are harmonics of it: the loads' and the meshes' orders.
+pub fn excitation_orders(scene: &Scene, basis: &HarmonicBasis) -> Vec<(f64, usize)> {
+    let nu = basis.subharmonic();
+    let f = scene.fundamental_order / nu as f64;
+    let loads = scene
+        .model
+        .loads()
+        .iter()
+        .filter(|l| l.order > 0)
+        .map(|l| l.order * nu);
+    let elements = scene.model.elements().iter();
+    let meshes = elements
+        .filter_map(|e| e.law().time_order())
+        .map(|z| z * nu);
+    let mut ks: Vec<usize> = loads
+        .chain(meshes)
+        .filter(|&k| k <= basis.harmonics())
+        .collect();
+    ks.sort_unstable();
+    ks.dedup();
+    ks.into_iter().map(|k| (k as f64 * f, k)).collect()
+}
+
+/// The modes of `scene` about its periodic solution (module documentation).
+///
+/// # Errors
+/// Bad input before any work: speeds out of range or `to <= from`, a non-positive
+/// `max_hz`, a model the harmonic balance refuses. An operating point that does not
+/// converge is a result without modes, marked ([`ModesAnalysis::exit_code`]).
+pub fn modes(scene: &Scene, settings: &ModesSettings) -> Result<ModesAnalysis> {
+    let speed = scene.basis.omega() / scene.omega_per_speed;
+    let (from, to) = (
+        settings.from.unwrap_or(0.0),
+        settings.to.unwrap_or(2.0 * speed),
+    );
+    super::check_speed(scene, "--from", from, true)?;
+    super::check_speed(scene, "--to", to, false)?;
+    let bad = |option: &str, reason: String| Error::InvalidOptions {
+        option: option.into(),
+        reason,
+    };
+    if to <= from {
+        let reason = format!("{to}: need 0 <= from < to (in {})", scene.speed_unit);
+        return Err(bad("--to", reason));
+    }
+    let max_hz = match settings.max_hz {
+        Some(f) if !(f.is_finite() && f > 0.0 && f <= crate::error::MAX_MAGNITUDE) => {
+            return Err(bad("--max-hz", format!("must be finite and > 0, got {f}")))
+        }
+        Some(f) => f,
+        None if scene.model.n_dofs() <= 300 => f64::INFINITY,
+        None => 5000.0,
+    };
+    let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, settings.formulation)?;
+    let sol = scene.method.solve(&hb, None, &mut hb.workspace())?;
+    let natural = match sol.is_converged() {
+        true => Some(natural_frequencies(&scene.model, &sol, max_hz)?),
+        false => None,
+    };
+    let orders: Vec<f64> = excitation_orders(scene, &scene.basis)
+        .into_iter()
+        .map(|(o, _)| o)
+        .collect();
+    let per_unit = scene.omega_per_speed / scene.fundamental_order;
+    let critical = natural
+        .as_ref()
+        .map(|nf| critical_speeds(nf, &orders, per_unit, (from, to)))
+        .unwrap_or_default();
+    Ok(ModesAnalysis {
+        file: scene.file.clone(),
+        unit: scene.speed_unit.to_string(),
+        operating_speed: speed,
+        range: (from, to),
+        max_hz,
+        termination: sol.termination,
+        natural,
+        orders,
+        critical,
+        dofs: scene.model.dof_names().to_vec(),
+        per_unit,
+    })
+}
+
+/// Where the order lines meet the elastic modes' mean frequencies within `range`.
+fn critical_speeds(
+    nf: &NaturalFrequencies,
+    orders: &[f64],
+    per_unit: f64,
+    (from, to): (f64, f64),
+) -> Vec<CriticalSpeed> {
+    let elastic = || nf.mean.iter().enumerate().filter(|(_, f)| **f > 0.0);
+    orders
+        .iter()
+        .flat_map(|&order| {
+            elastic().map(move |(i, &f)| CriticalSpeed {
+                order,
+                mode: i + 1,
+                speed: TAU * f / (order * per_unit),
+            })
+        })
+        .filter(|c| c.speed >= from && c.speed <= to)
+        .collect()
+}
+
+impl ModesAnalysis {
+    /// 0 with modes, 1 where the operating point did not converge (the document marked).
+    pub fn exit_code(&self) -> u8 {
+        u8::from(self.natural.is_none())
+    }
+
+    /// The JSON record: `hbal modes --json`.
+    pub fn to_json(&self) -> Value {
+        let Some(nf) = &self.natural else {
+            return json!({
+                "schema_version": super::SCHEMA_VERSION,
+                "scene": self.file,
+                "unit": self.unit,
+                "operating_speed": self.operating_speed,
+                "converged": false,
+                "termination": self.termination.to_string(),
+                "error": "the operating point did not converge: no linearisation",
+                "modes": [],
+                "critical_speeds": [],
+            });
+        };
+        let modes: Vec<Value> = nf
+            .mean
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                json!({
+                    "mean_hz": f,
+                    "lower_hz": nf.lower.get(i),
+                    "upper_hz": nf.upper.get(i),
+                    "shape": nf.shapes.column(i).iter().collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        json!({
+            "schema_version": super::SCHEMA_VERSION,
+            "scene": self.file,
+            "unit": self.unit,
+            "operating_speed": self.operating_speed,
+            "converged": true,
+            "rigid_modes": nf.rigid,
+            "modes": modes,
+            "dofs": self.dofs,
+            "orders": self.orders,
+            "critical_speeds": self.critical,
+        })
+    }
+}
+
+impl serde::Serialize for ModesAnalysis {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        self.to_json().serialize(s)
+    }
+}
