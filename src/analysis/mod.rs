@@ -27,6 +27,14 @@
 //! // What `hbal solve --json` prints:
 //! let json = serde_json::to_value(&analysis)?;
 //! assert_eq!(json["converged"], true);
+//! // What `hbal sweep --from 0.5 --to 2.6 --json` prints: through both folds of the
+//! // hardening Duffing oscillator.
+//! use hbal::analysis::{sweep, Silent, SweepSettings};
+//! let settings = SweepSettings { from: Some(0.5), ..SweepSettings::to(2.6) };
+//! let branch = sweep(&scene, &settings, &mut Silent)?;
+//! assert_eq!(branch.branch.folds(), 2);
+//! assert_eq!(branch.exit_code(), 0);
+//! assert_eq!(serde_json::to_value(&branch)?["reached"], true);
 //! # Ok(())
 //! # }
 //! ```

@@ -253,3 +253,49 @@ fn the_parameter_sweep_runs_in_the_library() {
     );
     assert_eq!(c.exit_code(), 1);
 }
+
+/// The library example (`examples/analyses.rs`, built by `cargo test` beside the tests)
+/// prints what `hbal solve --json` and `hbal sweep --json` print for the two-shaft scene.
+#[test]
+fn the_library_example_prints_what_the_cli_prints() {
+    let bin = Path::new(env!("CARGO_BIN_EXE_hbal"));
+    let example = bin.parent().unwrap().join("examples").join("analyses");
+    if !example.exists() {
+        // `cargo test --test integration` alone does not build the examples; `cargo test` does.
+        eprintln!("skipped: {} not built", example.display());
+        return;
+    }
+    let scene =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/two_shaft_6000rpm.toml");
+    let out = std::process::Command::new(&example)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2);
+    let cli = |args: &[&str]| -> Value {
+        let o = std::process::Command::new(bin)
+            .args(args)
+            .arg(&scene)
+            .output()
+            .unwrap();
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    for (line, args) in lines.iter().zip([
+        vec!["solve", "--json"],
+        vec!["sweep", "--json", "--to", "9000"],
+    ]) {
+        let mut mine: Value = serde_json::from_str(line).unwrap();
+        let mut theirs = cli(&args);
+        without_times(&mut mine);
+        without_times(&mut theirs);
+        assert_eq!(first_difference(&mine, &theirs, ""), None, "{args:?}");
+    }
+}
