@@ -107,7 +107,7 @@ fn table(a: &ModesAnalysis, nf: &NaturalFrequencies) {
 }
 
 /// `modes.csv` (frequencies and shapes) and `campbell.svg`.
-fn write_outputs(
+pub(crate) fn write_outputs(
     dir: &Path,
     scene: &Scene,
     nf: &NaturalFrequencies,

@@ -98,7 +98,12 @@ fn start_notes(scene: &Scene, file: &Path, s: &start::Start) {
 }
 
 /// The files of `--out DIR`.
-fn write_files(scene: &Scene, a: &SolveAnalysis, dir: &Path, as_json: bool) -> Result<(), Failure> {
+pub(crate) fn write_files(
+    scene: &Scene,
+    a: &SolveAnalysis,
+    dir: &Path,
+    as_json: bool,
+) -> Result<(), Failure> {
     let order =
         |k| hbal::analysis::order_of(k, scene.fundamental_order, a.solution.basis().subharmonic());
     // Files of an unconverged iterate say so in their names and plot titles.

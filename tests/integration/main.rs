@@ -25,6 +25,7 @@ mod cli_broken_scenes;
 mod cli_dofs;
 mod cli_start_files;
 mod cli_sweep;
+mod code_shape;
 mod condensation;
 mod condensation_branches;
 mod contact_quadrature;

@@ -1,15 +1,15 @@
-//! The page of `hbal report`: built from the JSON documents of `solve`, `sweep` and `modes`
-//! (the shapes documented in docs/scenes.md) and the SVG plots they wrote, inlined. One file
-//! per section of the page: the periodic solution, the run-up and the natural frequencies.
+//! The page of `hbal report`: built from the typed results of the library's solve, sweep and
+//! modes analyses and the SVG plots written from them, inlined. One file per section of the
+//! page: the periodic solution, the run-up and the natural frequencies.
 
 mod natural_frequencies;
 mod run_up;
 mod solution;
 
 use super::report::Part;
+use hbal::analysis::{ModesAnalysis, SolveAnalysis, SweepAnalysis};
 use hbal::report::{significant, HtmlReport};
 use hbal::scene::Scene;
-use serde_json::Value;
 use std::path::Path;
 
 /// Everything the page shows.
@@ -17,31 +17,32 @@ pub(crate) struct Inputs<'a> {
     pub(crate) scene: &'a Scene,
     pub(crate) scene_text: &'a str,
     pub(crate) dir: &'a Path,
-    pub(crate) solved: &'a Part,
-    pub(crate) swept: Option<&'a Part>,
-    pub(crate) moded: &'a Part,
+    pub(crate) solved: &'a Part<SolveAnalysis>,
+    pub(crate) swept: Option<&'a Part<SweepAnalysis>>,
+    pub(crate) moded: &'a Part<ModesAnalysis>,
 }
 
-/// A number of a JSON document with 4 significant digits, `–` where there is none.
-fn num(v: &Value) -> String {
-    v.as_f64().map_or("–".into(), |x| significant(x, 4))
+/// A number with 4 significant digits, `–` where there is none (or it is not finite).
+fn num(v: impl Into<Option<f64>>) -> String {
+    v.into()
+        .filter(|x| x.is_finite())
+        .map_or("–".into(), |x| significant(x, 4))
 }
 
 /// A percentage with one decimal.
-fn percent(v: &Value) -> String {
-    v.as_f64()
-        .map_or("–".into(), |x| format!("{:.1} %", 100.0 * x))
+fn percent(x: f64) -> String {
+    format!("{:.1} %", 100.0 * x)
 }
 
-/// The JSON document of `part`, or `None` after a failed status `no {what}: {error}`.
-fn document<'a>(r: &mut HtmlReport, part: &'a Part, what: &str) -> Option<&'a Value> {
-    if part.doc.is_none() {
+/// The result of `part`, or `None` after a failed status `no {what}: {error}`.
+fn result<'a, T>(r: &mut HtmlReport, part: &'a Part<T>, what: &str) -> Option<&'a T> {
+    if part.result.is_none() {
         r.status(
             false,
             &format!("no {what}: {}", part.error.as_deref().unwrap_or("unknown")),
         );
     }
-    part.doc.as_ref()
+    part.result.as_ref()
 }
 
 /// Inlines `dir/file` as a figure, or says it is missing.

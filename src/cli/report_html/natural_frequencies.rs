@@ -1,31 +1,35 @@
 //! The natural frequencies (linearised on the periodic solution), the critical speeds and
 //! the Campbell diagram.
 
-use super::{document, figure, num, Inputs};
+use super::{figure, num, result, Inputs};
 use hbal::report::HtmlReport;
 
 pub(super) fn modes_section(r: &mut HtmlReport, i: &Inputs) {
     let unit = i.scene.speed_unit;
     r.heading("Natural frequencies and critical speeds");
-    let Some(doc) = document(r, i.moded, "natural frequencies") else {
+    let Some(a) = result(r, i.moded, "natural frequencies") else {
         return;
     };
-    let modes = doc["modes"].as_array().map_or(&[][..], Vec::as_slice);
+    let Some(nf) = &a.natural else {
+        let why = format!(
+            "no natural frequencies: the operating point did not converge ({}): no linearisation",
+            a.termination
+        );
+        r.status(false, &why);
+        return;
+    };
     r.paragraph(&format!(
         "{} modes ({} rigid-body), linearised on the periodic solution; one- and two-tooth bounds of time-varying meshes.",
-        modes.len(),
-        doc["rigid_modes"]
+        nf.mean.len(),
+        nf.rigid
     ));
-    let rows: Vec<Vec<String>> = modes
-        .iter()
-        .enumerate()
-        .take(30)
-        .map(|(k, m)| {
+    let rows: Vec<Vec<String>> = (0..nf.mean.len().min(30))
+        .map(|k| {
             vec![
                 (k + 1).to_string(),
-                num(&m["mean_hz"]),
-                num(&m["lower_hz"]),
-                num(&m["upper_hz"]),
+                num(nf.mean[k]),
+                num(nf.lower.get(k).copied()),
+                num(nf.upper.get(k).copied()),
             ]
         })
         .collect();
@@ -38,13 +42,11 @@ pub(super) fn modes_section(r: &mut HtmlReport, i: &Inputs) {
         ],
         &rows,
     );
-    let critical = doc["critical_speeds"]
-        .as_array()
-        .map_or(&[][..], Vec::as_slice);
-    if !critical.is_empty() {
-        let rows: Vec<Vec<String>> = critical
+    if !a.critical.is_empty() {
+        let rows: Vec<Vec<String>> = a
+            .critical
             .iter()
-            .map(|c| vec![num(&c["speed"]), num(&c["order"]), c["mode"].to_string()])
+            .map(|c| vec![num(c.speed), num(c.order), c.mode.to_string()])
             .collect();
         let speed = format!("critical speed ({unit})");
         r.table(&[&speed, "order", "mode"], &rows);

@@ -1,44 +1,41 @@
 //! The run-up: its points, folds and stability, where contact opens, the order cuts, the
 //! waterfall and frequency responses.
 
-use super::{document, figure, num, percent, Inputs};
+use super::{figure, num, percent, result, Inputs};
 use crate::cli::report::Part;
+use hbal::analysis::SweepAnalysis;
+use hbal::continuation::BranchStop;
 use hbal::report::{significant, HtmlReport};
 
-/// Frequency-response plots shown (of the first DOFs the sweep wrote plots of, its
-/// `harmonics_dofs`; every one of those is in `sweep/`).
+/// Frequency-response plots shown (of the first DOFs the sweep wrote plots of, its reported
+/// DOFs; every one of those is in `sweep/`).
 const FREQUENCY_RESPONSES: usize = 2;
 
-pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
+pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part<SweepAnalysis>) {
     let unit = i.scene.speed_unit;
     r.heading("Run-up");
-    let Some(doc) = document(r, part, "run-up") else {
+    let Some(a) = result(r, part, "run-up") else {
         return;
     };
-    let points = doc["points"].as_array().map_or(&[][..], Vec::as_slice);
-    let unstable = points.iter().filter(|p| p["stable"] == false).count();
-    let largest = |key: &str| {
-        points
-            .iter()
-            .filter_map(|p| p[key].as_f64())
-            .fold(0.0f64, f64::max)
+    let points = &a.branch.points;
+    let unstable = points.iter().filter(|p| p.stable() == Some(false)).count();
+    let largest = |f: fn(&hbal::continuation::BranchPoint) -> Option<f64>| {
+        points.iter().filter_map(f).fold(0.0f64, f64::max)
     };
-    let (worst, kept) = (
-        largest("error_estimate"),
-        largest("error_estimate_harmonics"),
-    );
+    let worst = largest(|p| p.error_estimate);
+    let kept = largest(|p| p.error_estimate_harmonics);
     r.status(
-        doc["reached"].as_bool() == Some(true),
+        a.branch.stop == BranchStop::Reached,
         &format!(
             "{} points from {} to {} {unit}: {}",
             points.len(),
-            num(&doc["from"]),
-            num(&doc["to"]),
-            doc["stop"].as_str().unwrap_or("?")
+            num(a.from),
+            num(a.to),
+            a.branch.stop
         ),
     );
     r.facts(&[
-        ("folds", doc["folds"].to_string()),
+        ("folds", a.branch.folds().to_string()),
         ("unstable points", unstable.to_string()),
         (
             "largest error estimate",
@@ -48,17 +45,20 @@ pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
                 significant(kept, 2)
             ),
         ),
-        ("time", format!("{} s", num(&doc["seconds"]))),
+        ("time", format!("{} s", num(a.seconds))),
     ]);
-    if let Some(losses) = doc["contact_loss"].as_array().filter(|l| !l.is_empty()) {
-        let rows: Vec<Vec<String>> = losses
+    if a.contact_loss.is_empty() {
+        r.paragraph("No contact opens along the run-up.");
+    } else {
+        let rows: Vec<Vec<String>> = a
+            .contact_loss
             .iter()
             .map(|c| {
                 vec![
-                    c["element"].as_str().unwrap_or("?").to_string(),
-                    num(&c["from"]),
-                    num(&c["to"]),
-                    percent(&c["max_open"]),
+                    c.element.clone(),
+                    num(c.from),
+                    num(c.to),
+                    percent(c.max_open),
                 ]
             })
             .collect();
@@ -67,34 +67,18 @@ pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
             &["contact opens", &from, &to, "largest open fraction"],
             &rows,
         );
-    } else {
-        r.paragraph("No contact opens along the run-up.");
     }
     let dir = i.dir.join("sweep");
-    figure(
-        r,
-        &dir,
-        "order_cuts.svg",
-        "Order cuts: amplitude of each excitation order against speed",
-    );
+    let cuts = "Order cuts: amplitude of each excitation order against speed";
+    figure(r, &dir, "order_cuts.svg", cuts);
     figure(
         r,
         &dir,
         "waterfall.svg",
         "Waterfall: the spectrum at each speed",
     );
-    let written: Vec<&str> = doc["harmonics_dofs"]
-        .as_array()
-        .map(|a| a.iter().filter_map(|v| v.as_str()).collect())
-        .unwrap_or_else(|| {
-            i.scene
-                .model
-                .dof_names()
-                .iter()
-                .map(String::as_str)
-                .collect()
-        });
-    for dof in written.iter().take(FREQUENCY_RESPONSES) {
+    for &d in a.reported.iter().take(FREQUENCY_RESPONSES) {
+        let dof = &a.branch.dofs[d];
         figure(
             r,
             &dir,
@@ -102,10 +86,10 @@ pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part) {
             &format!("Frequency response of {dof} (stable solid, unstable dashed)"),
         );
     }
-    if written.len() > FREQUENCY_RESPONSES {
+    if a.reported.len() > FREQUENCY_RESPONSES {
         r.paragraph(&format!(
             "The frequency responses of the other {} DOFs are in sweep/.",
-            written.len() - FREQUENCY_RESPONSES
+            a.reported.len() - FREQUENCY_RESPONSES
         ));
     }
 }

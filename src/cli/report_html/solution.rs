@@ -1,9 +1,9 @@
 //! The periodic solution at the scene's speed: convergence, error estimate, stability, the
 //! time series and spectrum, the DOF and element tables.
 
-use super::{document, figure, num, percent, Inputs};
-use hbal::report::{significant, HtmlReport};
-use serde_json::Value;
+use super::{figure, num, percent, result, Inputs};
+use hbal::analysis::{order_of, SolveAnalysis, StabilityOutcome};
+use hbal::report::{significant, ElementOutput, HtmlReport};
 
 /// Most rows of the DOF table (the DOFs with the largest max |q| of a larger model).
 const MAX_DOF_ROWS: usize = 40;
@@ -15,131 +15,106 @@ pub(super) fn solve_section(r: &mut HtmlReport, i: &Inputs) {
         crate::cli::speed_text(scene.basis.omega() / scene.omega_per_speed),
         scene.speed_unit
     ));
-    let Some(doc) = document(r, i.solved, "solution") else {
+    let Some(a) = result(r, i.solved, "solution") else {
         return;
     };
-    let converged = doc["converged"].as_bool() == Some(true);
+    let sol = &a.solution;
+    let iterations = sol.stats.iterations;
     r.status(
-        converged,
+        sol.is_converged(),
         &format!(
-            "{} ({}) after {} iteration{}",
-            doc["termination"].as_str().unwrap_or("?"),
-            doc["method"].as_str().unwrap_or("?"),
-            doc["iterations"],
-            if doc["iterations"] == 1 { "" } else { "s" }
+            "{} ({}) after {iterations} iteration{}",
+            sol.termination,
+            a.method,
+            if iterations == 1 { "" } else { "s" }
         ),
     );
-    let estimate = &doc["error_estimate"];
-    let stability = &doc["stability"];
-    let stability_text = if let Some(u) = stability["unavailable"].as_str() {
-        u.to_string()
-    } else if let Some(e) = stability["error"].as_str() {
-        format!("failed: {e}")
-    } else if stability.is_null() {
-        "not computed".to_string()
-    } else {
-        format!(
-            "{}, max |μ| = {} ({} neutral), orbit correction {}",
-            if stability["stable"].as_bool() == Some(true) {
-                "stable"
-            } else {
-                "UNSTABLE"
-            },
-            num(&stability["max_abs"]),
-            stability["neutral"],
-            num(&stability["orbit_correction"])
-        )
-    };
+    let basis = sol.basis();
     r.facts(&[
-        ("relative residual", num(&doc["residual"])),
-        (
-            "error estimate",
-            match estimate["relative"].as_f64() {
-                Some(e) => format!(
-                    "{}{}, of harmonics 0..{} {} (against H = {}){}",
-                    if estimate["lower_bound"].as_bool() == Some(true) {
-                        "at least "
-                    } else {
-                        ""
-                    },
-                    significant(e, 2),
-                    doc["harmonics"],
-                    estimate["kept_harmonics"]
-                        .as_f64()
-                        .map_or("?".to_string(), |k| significant(k, 2)),
-                    estimate["reference_harmonics"],
-                    match doc["auto_harmonics"]["control"].as_str() {
-                        Some("harmonics") => "; automatic harmonics on the harmonics 0..H",
-                        Some(_) => "; automatic harmonics on the periodic solution",
-                        None => "",
-                    }
-                ),
-                None => estimate["error"]
-                    .as_str()
-                    .unwrap_or("none (not converged)")
-                    .to_string(),
-            },
-        ),
-        ("stability", stability_text),
+        ("relative residual", num(sol.residual())),
+        ("error estimate", estimate_text(a)),
+        ("stability", stability_text(&a.stability)),
         (
             "harmonics H, samples N",
-            format!("{}, {}", doc["harmonics"], doc["samples"]),
+            format!("{}, {}", basis.harmonics(), basis.samples()),
         ),
-        (
-            "fundamental",
-            format!("{} rad/s", num(&doc["fundamental_rad_s"])),
-        ),
-        (
-            "solve time",
-            format!(
-                "{} ms",
-                num(&(doc["solve_seconds"].as_f64().map(|s| s * 1e3)).into())
-            ),
-        ),
+        ("fundamental", format!("{} rad/s", num(basis.omega()))),
+        ("solve time", format!("{} ms", num(a.seconds.0 * 1e3))),
     ]);
-    let prefix = if converged { "" } else { "not_converged_" };
+    let prefix = if sol.is_converged() {
+        ""
+    } else {
+        "not_converged_"
+    };
     let dir = i.dir.join("solve");
     figure(r, &dir, &format!("{prefix}time_series.svg"), "One period");
-    figure(
-        r,
-        &dir,
-        &format!("{prefix}spectrum.svg"),
-        "Amplitude spectrum over the harmonics",
-    );
-    dof_table(r, i, doc);
-    element_table(r, doc);
+    let spectrum = "Amplitude spectrum over the harmonics";
+    figure(r, &dir, &format!("{prefix}spectrum.svg"), spectrum);
+    dof_table(r, i, a);
+    if let Ok(elements) = &a.elements {
+        element_table(r, elements);
+    }
 }
 
-fn dof_table(r: &mut HtmlReport, i: &Inputs, doc: &Value) {
+/// The error estimate in words: the whole, the harmonics 0..H, against which H.
+fn estimate_text(a: &SolveAnalysis) -> String {
+    match &a.estimate {
+        Some(Ok(e)) => format!(
+            "{}{}, of harmonics 0..{} {} (against H = {}){}",
+            if e.lower_bound { "at least " } else { "" },
+            significant(e.relative, 2),
+            a.solution.basis().harmonics(),
+            significant(e.kept_harmonics, 2),
+            e.reference_harmonics,
+            match a.auto.as_ref().map(|r| r.settings.control) {
+                Some(hbal::solve::Control::Harmonics) =>
+                    "; automatic harmonics on the harmonics 0..H",
+                Some(_) => "; automatic harmonics on the periodic solution",
+                None => "",
+            }
+        ),
+        Some(Err(e)) => e.clone(),
+        None => "none (not converged)".into(),
+    }
+}
+
+/// The stability in words.
+fn stability_text(s: &StabilityOutcome) -> String {
+    match s {
+        StabilityOutcome::Unavailable(u) => u.clone(),
+        StabilityOutcome::Failed(e) => format!("failed: {e}"),
+        StabilityOutcome::NotComputed => "not computed".into(),
+        StabilityOutcome::Computed(f) => format!(
+            "{}, max |μ| = {} ({} neutral), orbit correction {}",
+            if f.is_stable() { "stable" } else { "UNSTABLE" },
+            num(f.max_abs()),
+            f.neutral,
+            num(f.orbit_correction)
+        ),
+    }
+}
+
+/// Every DOF's max |q| and the amplitude of each excitation order.
+fn dof_table(r: &mut HtmlReport, i: &Inputs, a: &SolveAnalysis) {
     let orders: Vec<f64> = hbal::analysis::excitation_orders(i.scene, &i.scene.basis)
         .into_iter()
         .map(|o| o.0)
         .collect();
-    let Some(dofs) = doc["dofs"].as_array() else {
-        return;
+    let sol = &a.solution;
+    let (n, basis) = (sol.dof_names().len(), sol.basis());
+    let order = |k| order_of(k, a.fundamental_order, basis.subharmonic());
+    let amplitude = |d: usize, o: f64| {
+        (0..=basis.harmonics())
+            .find(|&k| (order(k) - o).abs() <= 1e-9 * o.max(1.0))
+            .map_or("–".into(), |k| {
+                significant(sol.harmonics()[k * n + d].norm(), 4)
+            })
     };
-    let mut rows: Vec<(f64, Vec<String>)> = dofs
-        .iter()
+    let mut rows: Vec<(f64, Vec<String>)> = (0..n)
         .map(|d| {
-            let amplitude = |o: f64| {
-                d["harmonics"]
-                    .as_array()
-                    .and_then(|hs| {
-                        hs.iter().find(|h| {
-                            h["shaft_order"]
-                                .as_f64()
-                                .is_some_and(|x| (x - o).abs() <= 1e-9 * o.max(1.0))
-                        })
-                    })
-                    .map_or("–".into(), |h| {
-                        let (c, s) = (h["cos"].as_f64(), h["sin"].as_f64());
-                        significant(c.unwrap_or(0.0).hypot(s.unwrap_or(0.0)), 4)
-                    })
-            };
-            let mut row = vec![d["name"].as_str().unwrap_or("?").to_string()];
-            row.push(num(&d["max_abs"]));
-            row.extend(orders.iter().map(|&o| amplitude(o)));
-            (d["max_abs"].as_f64().unwrap_or(0.0), row)
+            let mut row = vec![sol.dof_names()[d].clone(), num(a.max_abs[d])];
+            row.extend(orders.iter().map(|&o| amplitude(d, o)));
+            (a.max_abs[d], row)
         })
         .collect();
     r.heading("DOFs");
@@ -158,10 +133,9 @@ fn dof_table(r: &mut HtmlReport, i: &Inputs, doc: &Value) {
     r.table(&header, &rows);
 }
 
-fn element_table(r: &mut HtmlReport, doc: &Value) {
-    let Some(elements) = doc["elements"].as_array() else {
-        return;
-    };
+/// Every element's coordinate, force and contact states; the gear stages' transmission
+/// error and mesh forces.
+fn element_table(r: &mut HtmlReport, elements: &[ElementOutput]) {
     if elements.is_empty() {
         return;
     }
@@ -169,70 +143,56 @@ fn element_table(r: &mut HtmlReport, doc: &Value) {
     let rows: Vec<Vec<String>> = elements
         .iter()
         .map(|e| {
-            let states: Vec<String> = e["states"]
-                .as_array()
-                .map(|s| {
-                    s.iter()
-                        .map(|s| {
-                            format!(
-                                "{} {}",
-                                s["state"].as_str().unwrap_or("?"),
-                                percent(&s["fraction"])
-                            )
-                        })
-                        .collect()
-                })
-                .unwrap_or_default();
+            let states: Vec<String> = e
+                .states
+                .iter()
+                .map(|(s, f)| format!("{s} {}", percent(*f)))
+                .collect();
             vec![
-                e["name"].as_str().unwrap_or("?").to_string(),
-                e["type"].as_str().unwrap_or("?").to_string(),
-                num(&e["coordinate"]["mean"]),
-                num(&e["coordinate"]["peak_to_peak"]),
-                num(&e["force"]["mean"]),
-                format!("{} … {}", num(&e["force"]["min"]), num(&e["force"]["max"])),
+                e.name.clone(),
+                e.kind.clone(),
+                num(e.coordinate.mean()),
+                num(e.coordinate.peak_to_peak()),
+                num(e.force.mean()),
+                format!("{} … {}", num(e.force.min), num(e.force.max)),
                 states.join(", "),
             ]
         })
         .collect();
-    r.table(
-        &[
-            "element",
-            "type",
-            "u mean (m or rad)",
-            "u peak to peak",
-            "f mean (N or N m)",
-            "f min … max",
-            "contact states",
-        ],
-        &rows,
-    );
+    let header = [
+        "element",
+        "type",
+        "u mean (m or rad)",
+        "u peak to peak",
+        "f mean (N or N m)",
+        "f min … max",
+        "contact states",
+    ];
+    r.table(&header, &rows);
     let stages: Vec<Vec<String>> = elements
         .iter()
-        .filter(|e| e["gear_stage"].is_object())
-        .map(|e| {
-            let g = &e["gear_stage"];
-            let te = g["te_unit"].as_str().unwrap_or("µm");
+        .filter_map(|e| e.mesh.as_ref().map(|g| (e, g)))
+        .map(|(e, g)| {
+            let te = g.te_unit;
             vec![
-                e["name"].as_str().unwrap_or("?").to_string(),
-                format!("{} {te}", num(&g["te_mean"])),
-                format!("{} {te}", num(&g["te_peak_to_peak"])),
-                num(&g["force_mean"]),
-                num(&g["dynamic_force"]),
-                num(&g["dynamic_factor"]),
+                e.name.clone(),
+                format!("{} {te}", num(g.te_mean)),
+                format!("{} {te}", num(g.te_peak_to_peak)),
+                num(g.force_mean),
+                num(g.dynamic_force),
+                num(g.dynamic_factor),
             ]
         })
         .collect();
     if !stages.is_empty() {
-        r.table(
-            &[
-                "gear stage",
-                "TE mean",
-                "TE peak to peak",
-                "mesh force mean (N)",
-                "dynamic mesh force (N)",
-                "dynamic factor",
-            ],
-            &stages,
-        );
+        let header = [
+            "gear stage",
+            "TE mean",
+            "TE peak to peak",
+            "mesh force mean (N)",
+            "dynamic mesh force (N)",
+            "dynamic factor",
+        ];
+        r.table(&header, &stages);
     }
 }
