@@ -36,6 +36,7 @@ mod solve_files;
 mod solve_text;
 pub(crate) mod start;
 pub(crate) mod sweep;
+pub(crate) mod sweep_command;
 mod sweep_files;
 pub(crate) mod sweep_summary;
 mod sweep_text;
@@ -170,18 +171,6 @@ pub(crate) fn speed_text(v: f64) -> String {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
         s
-    }
-}
-
-/// Where a subcommand's JSON document goes when it is kept instead of printed: `hbal report`
-/// runs `solve`, `sweep` and `modes` and reads their documents from here.
-pub(crate) type Capture<'a> = Option<&'a mut Option<serde_json::Value>>;
-
-/// Prints `doc` on stdout, or keeps it in `capture`.
-pub(crate) fn emit(doc: serde_json::Value, capture: Capture) {
-    match capture {
-        Some(slot) => *slot = Some(doc),
-        None => say!("{doc}"),
     }
 }
 

@@ -18,12 +18,10 @@ pub(crate) struct ModesOptions<'a> {
     pub(crate) max_hz: Option<f64>,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
-    /// Keep the JSON document here instead of printing anything (for `hbal report`).
-    pub(crate) capture: super::Capture<'a>,
 }
 
 pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Result<u8, Failure> {
-    let as_json = opts.json || opts.capture.is_some();
+    let as_json = opts.json;
     let scene = load(path, args)?;
     if let Some(dir) = opts.out {
         super::prepare_out(dir)?;
@@ -36,10 +34,10 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     };
     let a = hbal::analysis::modes(&scene, &settings).map_err(|e| super::failure(e, &scene.file))?;
     let Some(nf) = &a.natural else {
-        if opts.json && opts.capture.is_none() {
+        if opts.json {
             // The document still comes, marked: what failed instead of the modes (the
             // report says it in its page instead).
-            super::emit(a.to_json(), opts.capture);
+            say!("{}", a.to_json());
         }
         return Err(Failure {
             code: 1,
@@ -51,7 +49,7 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
         });
     };
     if as_json {
-        super::emit(a.to_json(), opts.capture);
+        say!("{}", a.to_json());
     } else {
         table(&a, nf);
     }

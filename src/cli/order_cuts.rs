@@ -102,47 +102,105 @@ pub(crate) fn write(
     shows: Shows,
     speed: impl Fn(f64) -> f64,
 ) -> anyhow::Result<()> {
-    let Shows {
-        dofs,
-        plotted: shown,
-    } = shows;
     let orders = hbal::analysis::excitation_orders(scene, basis);
-    let n = branch.dofs.len();
-    let mut w = csv::Writer::from_path(dir.join("order_cuts.csv"))?;
-    let mut header = vec![scene.speed_unit.to_string()];
-    let dof_columns = dofs.len();
-    let names: Vec<String> = dofs
+    csv_of(
+        &dir.join("order_cuts.csv"),
+        scene,
+        branch,
+        outputs,
+        shows.dofs,
+        &orders,
+        &speed,
+    )?;
+    let (amplitude, what, unit) = shown_amplitude(scene, branch, shows.plotted);
+    let title = |kind: &str| format!("{kind} of the {what}: {}", scene.file);
+    let speed_axis = format!("speed ({})", scene.speed_unit);
+    let points = || branch.points.iter().zip(outputs);
+    if branch.points.len() < 2 {
+        return Ok(());
+    }
+    let series: Vec<Series> = orders
         .iter()
-        .map(|&i| branch.dofs[i].clone())
-        .chain(
-            scene
-                .model
-                .elements()
-                .iter()
-                .map(|e| format!("u({})", e.name())),
+        .map(|&(o, k)| {
+            let curve = points().map(|(p, out)| (speed(p.omega), amplitude(p, out, k)));
+            Series::line(format!("order {o}"), curve.collect())
+        })
+        .collect();
+    if !series.is_empty() {
+        let y = Axis::auto(format!("amplitude ({unit})"));
+        line_plot(
+            &dir.join("order_cuts.svg"),
+            &title("Order cuts"),
+            &Axis::linear(&speed_axis),
+            &y,
+            &series,
         )
-        .collect();
-    for name in &names {
-        for (o, _) in &orders {
-            header.push(format!("amp_{name}_order_{o}"));
-            header.push(format!("phase_deg_{name}_order_{o}"));
-        }
+        .unwrap_or_else(super::plot_warning);
     }
-    let contacts: Vec<usize> = (0..scene.model.elements().len())
-        .filter(|&i| !scene.model.elements()[i].law().kinks().is_empty())
-        .collect();
-    for &i in &contacts {
-        header.push(format!("open_{}", scene.model.elements()[i].name()));
-    }
-    w.write_record(&header)?;
-    let (amplitude, what, unit) = shown_amplitude(scene, branch, shown);
-    let mut curves: Vec<Vec<(f64, f64)>> = vec![Vec::new(); orders.len()];
     // The waterfall's orders: up to twice the highest excitation harmonic (at least 4).
     let top_k = orders.iter().map(|o| o.1).max().unwrap_or(1);
     let stems = (2 * top_k).max(4).min(branch.harmonics);
     let order_of =
         |k: usize| super::element_report::order_of(k, scene.fundamental_order, basis.subharmonic());
-    let mut slices = Vec::with_capacity(branch.points.len());
+    let slices: Vec<Slice> = points()
+        .map(|(p, out)| Slice {
+            speed: speed(p.omega),
+            amplitudes: (1..=stems)
+                .map(|k| (order_of(k), amplitude(p, out, k)))
+                .collect(),
+        })
+        .collect();
+    if stems > 0 {
+        let highlight: Vec<f64> = orders.iter().map(|o| o.0).collect();
+        let waterfall = Waterfall {
+            title: &title("Waterfall"),
+            speed_label: &speed_axis,
+            unit,
+            range_db: 60.0,
+            highlight: &highlight,
+        };
+        waterfall_plot(&dir.join("waterfall.svg"), &waterfall, &slices)
+            .unwrap_or_else(super::plot_warning);
+    }
+    Ok(())
+}
+
+/// `order_cuts.csv`: at every point the amplitude and phase of each excitation order of the
+/// `dofs` and every element coordinate, and the open fraction of every contact.
+fn csv_of(
+    path: &Path,
+    scene: &Scene,
+    branch: &Branch,
+    outputs: &[Vec<ElementOutput>],
+    dofs: &[usize],
+    orders: &[(f64, usize)],
+    speed: impl Fn(f64) -> f64,
+) -> anyhow::Result<()> {
+    let n = branch.dofs.len();
+    let mut w = csv::Writer::from_path(path)?;
+    let mut header = vec![scene.speed_unit.to_string()];
+    let dof_columns = dofs.len();
+    let elements = scene.model.elements();
+    let names: Vec<String> = dofs
+        .iter()
+        .map(|&i| branch.dofs[i].clone())
+        .chain(elements.iter().map(|e| format!("u({})", e.name())))
+        .collect();
+    for name in &names {
+        for (o, _) in orders {
+            header.push(format!("amp_{name}_order_{o}"));
+            header.push(format!("phase_deg_{name}_order_{o}"));
+        }
+    }
+    let contacts: Vec<usize> = (0..elements.len())
+        .filter(|&i| !elements[i].law().kinks().is_empty())
+        .collect();
+    header.extend(
+        contacts
+            .iter()
+            .map(|&i| format!("open_{}", elements[i].name())),
+    );
+    w.write_record(&header)?;
     for (p, outputs) in branch.points.iter().zip(outputs) {
         let mut row = vec![format!("{:e}", speed(p.omega))];
         let harmonic_of = |name: usize, k: usize| {
@@ -153,7 +211,7 @@ pub(crate) fn write(
             }
         };
         for name in 0..names.len() {
-            for &(_, k) in &orders {
+            for &(_, k) in orders {
                 let x = harmonic_of(name, k);
                 row.push(format!("{:e}", x.norm()));
                 // q = Re(Q e^{ikθ}) = |Q| cos(kθ + arg Q).
@@ -161,58 +219,10 @@ pub(crate) fn write(
             }
         }
         for &i in &contacts {
-            let open = outputs[i]
-                .states
-                .iter()
-                .find(|(s, _)| s == "open")
-                .map_or(f64::NAN, |(_, f)| *f);
-            row.push(if open.is_nan() {
-                String::new()
-            } else {
-                format!("{open:e}")
-            });
+            let open = outputs[i].states.iter().find(|(s, _)| s == "open");
+            row.push(open.map_or(String::new(), |(_, f)| format!("{f:e}")));
         }
         w.write_record(&row)?;
-        for (c, &(_, k)) in curves.iter_mut().zip(&orders) {
-            c.push((speed(p.omega), amplitude(p, outputs, k)));
-        }
-        slices.push(Slice {
-            speed: speed(p.omega),
-            amplitudes: (1..=stems)
-                .map(|k| (order_of(k), amplitude(p, outputs, k)))
-                .collect(),
-        });
     }
-    w.flush()?;
-    let series: Vec<Series> = curves
-        .into_iter()
-        .zip(&orders)
-        .map(|(c, (o, _))| Series::line(format!("order {o}"), c))
-        .collect();
-    if branch.points.len() >= 2 && !series.is_empty() {
-        line_plot(
-            &dir.join("order_cuts.svg"),
-            &format!("Order cuts of the {what}: {}", scene.file),
-            &Axis::linear(format!("speed ({})", scene.speed_unit)),
-            &Axis::auto(format!("amplitude ({unit})")),
-            &series,
-        )
-        .unwrap_or_else(super::plot_warning);
-    }
-    if branch.points.len() >= 2 && stems > 0 {
-        let highlight: Vec<f64> = orders.iter().map(|o| o.0).collect();
-        waterfall_plot(
-            &dir.join("waterfall.svg"),
-            &Waterfall {
-                title: &format!("Waterfall of the {what}: {}", scene.file),
-                speed_label: &format!("speed ({})", scene.speed_unit),
-                unit,
-                range_db: 60.0,
-                highlight: &highlight,
-            },
-            &slices,
-        )
-        .unwrap_or_else(super::plot_warning);
-    }
-    Ok(())
+    Ok(w.flush()?)
 }

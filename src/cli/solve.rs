@@ -18,12 +18,10 @@ pub(crate) struct SolveOptions<'a> {
     pub(crate) fallback: bool,
     pub(crate) json: bool,
     pub(crate) out: Option<&'a Path>,
-    /// Keep the JSON document here instead of printing anything (for `hbal report`).
-    pub(crate) capture: super::Capture<'a>,
 }
 
 pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Result<u8, Failure> {
-    let as_json = opts.json || opts.capture.is_some();
+    let as_json = opts.json;
     let scene = load(path, args)?;
     if let Some(dir) = opts.out {
         super::prepare_out(dir)?;
@@ -55,7 +53,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         }
     }
     if as_json {
-        super::emit(a.to_json(), opts.capture);
+        say!("{}", a.to_json());
     } else {
         super::solve_text::print(&scene, &a, opts.stability);
     }

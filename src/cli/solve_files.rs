@@ -25,33 +25,63 @@ pub(crate) fn write_outputs(
 ) -> anyhow::Result<Vec<String>> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let file = |name: &str| dir.join(format!("{}{name}", label.prefix));
-    let h = sol.basis().harmonics();
-    // CSV through the csv writer: a DOF name with a comma or a quote is quoted.
-    let mut w = csv::Writer::from_path(file("harmonics.csv"))?;
-    w.write_record(["dof", "harmonic", "shaft_order", "cos", "sin"])?;
-    for (i, name) in sol.dof_names().iter().enumerate() {
-        for k in 0..=h {
-            let (c, s) = sol.cos_sin(i, k);
-            w.write_record([
-                name.clone(),
-                k.to_string(),
-                order(k).to_string(),
-                format!("{c:e}"),
-                format!("{s:e}"),
-            ])?;
-        }
-    }
-    w.flush()?;
-    let mut written = vec![format!("{}harmonics.csv", label.prefix)];
-    let period = sol.basis().period();
+    harmonics_csv(&file("harmonics.csv"), sol, order)?;
     let series: Vec<Vec<f64>> = series.unwrap_or_else(|| {
         let points = sol.basis().samples().max(256);
         (0..sol.dof_names().len())
             .map(|i| sol.time_series(i, points))
             .collect()
     });
+    time_series_csv(&file("time_series.csv"), sol, &series)?;
+    let mut written = vec![
+        format!("{}harmonics.csv", label.prefix),
+        format!("{}time_series.csv", label.prefix),
+    ];
+    // A plot that cannot be drawn is a warning: the solve and its CSV files stand.
+    let mut plotted = |name: &str, result: Result<(), Box<dyn std::error::Error>>| match result {
+        Ok(()) => written.push(format!("{}{name}", label.prefix)),
+        Err(e) => eprintln!("warning: {name}: {e}"),
+    };
+    let (shown, note) = plotted_dofs(sol, sol.basis().harmonics());
+    let title = format!("{}: one period{note}", label.title);
+    let plot = time_series_plot(&file("time_series.svg"), sol, &series, &shown, &title);
+    plotted("time_series.svg", plot);
+    let title = format!(
+        "{}: amplitude spectrum (static part omitted){note}",
+        label.title
+    );
+    if let Some(plot) = spectrum_plot(&file("spectrum.svg"), sol, &shown, &title) {
+        plotted("spectrum.svg", plot);
+    }
+    Ok(written)
+}
+
+/// `harmonics.csv`: every DOF's cos and sin of every harmonic with its shaft order.
+fn harmonics_csv(path: &Path, sol: &Solution, order: impl Fn(usize) -> f64) -> anyhow::Result<()> {
+    // CSV through the csv writer: a DOF name with a comma or a quote is quoted.
+    let mut w = csv::Writer::from_path(path)?;
+    w.write_record(["dof", "harmonic", "shaft_order", "cos", "sin"])?;
+    for (i, name) in sol.dof_names().iter().enumerate() {
+        for k in 0..=sol.basis().harmonics() {
+            let (c, s) = sol.cos_sin(i, k);
+            let row = [
+                name.clone(),
+                k.to_string(),
+                order(k).to_string(),
+                format!("{c:e}"),
+                format!("{s:e}"),
+            ];
+            w.write_record(row)?;
+        }
+    }
+    Ok(w.flush()?)
+}
+
+/// `time_series.csv`: t, θ and every DOF's `series` over one period.
+fn time_series_csv(path: &Path, sol: &Solution, series: &[Vec<f64>]) -> anyhow::Result<()> {
+    let period = sol.basis().period();
     let points = series.first().map_or(0, Vec::len);
-    let mut w = csv::Writer::from_path(file("time_series.csv"))?;
+    let mut w = csv::Writer::from_path(path)?;
     let mut header = vec!["t".to_string(), "theta".to_string()];
     header.extend(sol.dof_names().iter().cloned());
     w.write_record(&header)?;
@@ -64,73 +94,63 @@ pub(crate) fn write_outputs(
         row.extend(series.iter().map(|s| format!("{:e}", s[j])));
         w.write_record(&row)?;
     }
-    w.flush()?;
-    written.push(format!("{}time_series.csv", label.prefix));
-    // A plot that cannot be drawn is a warning: the solve and its CSV files stand.
-    let mut plotted = |name: &str, result: Result<(), Box<dyn std::error::Error>>| match result {
-        Ok(()) => written.push(format!("{}{name}", label.prefix)),
-        Err(e) => eprintln!("warning: {name}: {e}"),
-    };
-    let (shown, note) = plotted_dofs(sol, h);
+    Ok(w.flush()?)
+}
+
+/// The time series of the `shown` DOFs over one period.
+fn time_series_plot(
+    path: &Path,
+    sol: &Solution,
+    series: &[Vec<f64>],
+    shown: &[usize],
+    title: &str,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let period = sol.basis().period();
+    let points = series.first().map_or(0, Vec::len);
     let names = sol.dof_names();
     let lines: Vec<Series> = shown
         .iter()
-        .map(|&i| (&names[i], &series[i]))
-        .map(|(name, s)| {
-            Series::line(
-                name.clone(),
-                s.iter()
-                    .enumerate()
-                    .map(|(j, v)| (j as f64 / points as f64 * period, *v))
-                    .collect(),
-            )
+        .map(|&i| {
+            let s = series[i].iter().enumerate();
+            let xy = s
+                .map(|(j, v)| (j as f64 / points as f64 * period, *v))
+                .collect();
+            Series::line(names[i].clone(), xy)
         })
         .collect();
-    plotted(
-        "time_series.svg",
-        line_plot(
-            &file("time_series.svg"),
-            &format!("{}: one period{note}", label.title),
-            &Axis::linear("t (s)"),
-            &Axis::linear("q (rad or m)"),
-            &lines,
-        ),
-    );
+    let (x, y) = (Axis::linear("t (s)"), Axis::linear("q (rad or m)"));
+    line_plot(path, title, &x, &y, &lines)
+}
+
+/// The amplitude spectrum of the `shown` DOFs; `None` for a static solution (every harmonic
+/// k >= 1 zero), which has none.
+fn spectrum_plot(
+    path: &Path,
+    sol: &Solution,
+    shown: &[usize],
+    title: &str,
+) -> Option<Result<(), Box<dyn std::error::Error>>> {
+    let h = sol.basis().harmonics();
     // Amplitudes below 1e-13 of the largest are rounding noise: left out.
     let largest = shown
         .iter()
         .flat_map(|&i| (1..=h).map(move |k| sol.harmonic(i, k).norm()))
         .fold(0.0f64, f64::max);
+    if h == 0 || largest <= 0.0 {
+        return None;
+    }
     let spectra: Vec<Series> = shown
         .iter()
-        .map(|&i| (i, &names[i]))
-        .map(|(i, name)| {
+        .map(|&i| {
+            let ks = (1..=h).map(|k| (k as f64, sol.harmonic(i, k).norm()));
             Series::markers(
-                name.clone(),
-                (1..=h)
-                    .map(|k| (k as f64, sol.harmonic(i, k).norm()))
-                    .filter(|&(_, a)| a > 1e-13 * largest)
-                    .collect(),
+                sol.dof_names()[i].clone(),
+                ks.filter(|&(_, a)| a > 1e-13 * largest).collect(),
             )
         })
         .collect();
-    // A static solution (every harmonic k >= 1 zero) has no spectrum to plot.
-    if h > 0 && largest > 0.0 {
-        plotted(
-            "spectrum.svg",
-            line_plot(
-                &file("spectrum.svg"),
-                &format!(
-                    "{}: amplitude spectrum (static part omitted){note}",
-                    label.title
-                ),
-                &Axis::linear("harmonic k"),
-                &Axis::log("|q_k| (rad or m)"),
-                &spectra,
-            ),
-        );
-    }
-    Ok(written)
+    let (x, y) = (Axis::linear("harmonic k"), Axis::log("|q_k| (rad or m)"));
+    Some(line_plot(path, title, &x, &y, &spectra))
 }
 
 /// Most DOFs a plot shows (a legend of a thousand names hides the data).

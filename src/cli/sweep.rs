@@ -26,8 +26,6 @@ pub(crate) struct SweepOptions<'a> {
     pub(crate) error_estimate: bool,
     /// The element or DOF the order-cut plot and the waterfall show.
     pub(crate) output: Option<&'a str>,
-    /// Keep the JSON document here instead of printing anything (for `hbal report`).
-    pub(crate) capture: super::Capture<'a>,
     /// `--dofs`: the DOFs whose harmonics and plots are written.
     pub(crate) dofs: Option<&'a str>,
 }
@@ -55,7 +53,7 @@ impl SweepOptions<'_> {
 }
 
 pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
-    let as_json = opts.json || opts.capture.is_some();
+    let as_json = opts.json;
     let scene = load(path, args)?;
     if let Some(dir) = opts.out {
         for dof in scene.model.dof_names() {
@@ -78,7 +76,7 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         eprintln!("note: {}", note.describe(&analysis.unit));
     }
     if as_json {
-        super::emit(analysis.to_json(), opts.capture);
+        say!("{}", analysis.to_json());
     } else {
         super::sweep_text::print(&scene, &analysis, opts.out.is_some());
     }
