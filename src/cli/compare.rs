@@ -16,7 +16,7 @@ pub(crate) fn compare(
 ) -> Result<u8, Failure> {
     let scene = load(path, args)?;
     if let Some(dir) = out {
-        super::prepare_out(dir)?;
+        super::prepare_out(dir, &["residual_histories.svg".to_string()])?;
     }
     let settings = CompareSettings {
         methods: args

@@ -174,16 +174,72 @@ pub(crate) fn speed_text(v: f64) -> String {
     }
 }
 
-/// Makes `--out DIR` ready before any work: creates it and writes and removes a probe file,
-/// so that an unwritable directory is bad input (exit 2) instead of a failure after the run.
-pub(crate) fn prepare_out(dir: &Path) -> Result<(), Failure> {
+/// Makes `--out DIR` ready before any work: creates it, writes and removes a probe file, and
+/// checks that none of `files` (the names the subcommand writes there) is a directory or a
+/// file it cannot write, so that an unusable directory is bad input (exit 2, nothing written)
+/// instead of a failure after the run.
+pub(crate) fn prepare_out(dir: &Path, files: &[String]) -> Result<(), Failure> {
     std::fs::create_dir_all(dir)
         .with_context(|| format!("--out {}: cannot create the directory", dir.display()))?;
     let probe = dir.join(".hbal_write_test");
     std::fs::write(&probe, b"")
         .with_context(|| format!("--out {}: cannot write into the directory", dir.display()))?;
     let _ = std::fs::remove_file(probe);
+    for name in files {
+        let path = dir.join(name);
+        let Ok(meta) = std::fs::metadata(&path) else {
+            continue;
+        };
+        if meta.is_dir() {
+            return Err(anyhow::anyhow!(
+                "--out {}: {} is a directory where hbal writes a file: move it or choose another --out",
+                dir.display(),
+                path.display()
+            )
+            .into());
+        }
+        std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .with_context(|| format!("--out {}: cannot write {}", dir.display(), path.display()))?;
+    }
     Ok(())
+}
+
+/// The files `hbal solve --out` writes (those of a converged solve and of an unconverged
+/// iterate).
+pub(crate) fn solve_files() -> Vec<String> {
+    let names = [
+        "harmonics.csv",
+        "time_series.csv",
+        "elements.csv",
+        "time_series.svg",
+        "spectrum.svg",
+    ];
+    let prefixed = names.iter().map(|n| format!("not_converged_{n}"));
+    names
+        .iter()
+        .map(|n| n.to_string())
+        .chain(prefixed)
+        .collect()
+}
+
+/// The files `hbal sweep --out` writes besides the switched branches' (`branch_1.csv`, ...):
+/// the branch, the order cuts and one frequency response per reported DOF of `dofs`.
+pub(crate) fn sweep_files<'a>(dofs: impl Iterator<Item = &'a String>) -> Vec<String> {
+    let names = [
+        "branch.csv",
+        "order_cuts.csv",
+        "order_cuts.svg",
+        "waterfall.svg",
+    ];
+    let plots = dofs.map(|d| format!("frequency_response_{d}.svg"));
+    names.iter().map(|n| n.to_string()).chain(plots).collect()
+}
+
+/// The files `hbal modes --out` writes.
+pub(crate) fn modes_files() -> Vec<String> {
+    vec!["modes.csv".into(), "campbell.svg".into()]
 }
 
 /// Checks that `name` (of a DOF or an element, `what`) can be part of a file name in `--out`:

@@ -24,7 +24,7 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     let as_json = opts.json;
     let scene = load(path, args)?;
     if let Some(dir) = opts.out {
-        super::prepare_out(dir)?;
+        super::prepare_out(dir, &super::modes_files())?;
     }
     let settings = ModesSettings {
         from: opts.from,
@@ -56,7 +56,8 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     if let Some(dir) = opts.out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--out: cannot create {}", dir.display()))?;
-        write_outputs(dir, &scene, nf, &a.orders, a.range, a.per_unit)?;
+        write_outputs(dir, &scene, nf, &a.orders, a.range, a.per_unit)
+            .with_context(|| format!("--out: cannot write into {}", dir.display()))?;
         if !as_json {
             say!("  wrote modes.csv, campbell.svg to {}", dir.display());
         }

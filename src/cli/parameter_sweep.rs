@@ -50,14 +50,16 @@ pub(crate) fn parameter_sweep(
     if let Some(dir) = opts.out {
         // The DOF names of the first value make the file names.
         let mut first = doc.clone();
+        let mut files = vec!["branch.csv".to_string()];
         if hbal::scene::set_parameter(&mut first, name, from).is_ok() {
             if let Ok(scene) = Scene::from_value(first, &file) {
                 for dof in scene.model.dof_names() {
                     super::file_name_part(dof, "DOF")?;
+                    files.push(format!("parameter_response_{dof}.svg"));
                 }
             }
         }
-        super::prepare_out(dir)?;
+        super::prepare_out(dir, &files)?;
     }
     let bar = super::progress::Progress::new("parameter sweep", opts.json);
     let a = hbal::analysis::parameter_sweep(&doc, &file, &settings, &mut &bar)

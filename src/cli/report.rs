@@ -125,7 +125,18 @@ fn check(path: &Path, args: &SolverArgs, opts: &ReportOptions) -> Result<Scene, 
     for dof in scene.model.dof_names() {
         super::file_name_part(dof, "DOF")?;
     }
-    super::prepare_out(opts.out)?;
+    // report.html, and the parts' files in their folders.
+    let out = opts.out;
+    super::prepare_out(out, &["report.html".to_string()])?;
+    super::prepare_out(&out.join("solve"), &super::solve_files())?;
+    if opts.to.is_some() {
+        let names = scene.model.dof_names();
+        let reported = hbal::analysis::reported_dofs(&scene.model, None)
+            .map_err(|e| super::failure(e, &scene.file))?;
+        let files = super::sweep_files(reported.iter().map(|&i| &names[i]));
+        super::prepare_out(&out.join("sweep"), &files)?;
+    }
+    super::prepare_out(&out.join("modes"), &super::modes_files())?;
     Ok(scene)
 }
 
@@ -144,7 +155,6 @@ fn solve_part(scene: &Scene, args: &SolverArgs, opts: &ReportOptions) -> Part<So
         scene.file
     );
     Part::run(analysis, SolveAnalysis::exit_code, &failed, |a| {
-        super::prepare_out(&dir)?;
         super::solve::write_files(scene, a, &dir, true)
     })
 }
@@ -172,7 +182,6 @@ fn sweep_part(
         Err(_) => String::new(),
     };
     Part::run(analysis, SweepAnalysis::exit_code, &failed, |a| {
-        super::prepare_out(&dir)?;
         Ok(super::sweep_files::write(&dir, scene, a)?)
     })
 }
@@ -204,7 +213,6 @@ fn modes_part(scene: &Scene, args: &SolverArgs, opts: &ReportOptions) -> Part<Mo
     };
     Part::run(analysis, ModesAnalysis::exit_code, &failed, |a| {
         let Some(nf) = &a.natural else { return Ok(()) };
-        super::prepare_out(&dir)?;
         Ok(super::modes::write_outputs(
             &dir, scene, nf, &a.orders, a.range, a.per_unit,
         )?)

@@ -24,7 +24,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
     let as_json = opts.json;
     let scene = load(path, args)?;
     if let Some(dir) = opts.out {
-        super::prepare_out(dir)?;
+        super::prepare_out(dir, &super::solve_files())?;
     }
     let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
     if let (Some(file), Some(s)) = (opts.start, &start) {

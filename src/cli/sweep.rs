@@ -3,6 +3,7 @@
 //! summary ([`super::sweep_text`]) and as files in `--out` ([`super::sweep_files`]).
 
 use super::{load, start, Failure, SolverArgs};
+use anyhow::Context;
 use hbal::analysis::{SweepAnalysis, SweepSettings, SweepStart};
 use std::path::Path;
 
@@ -59,7 +60,13 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         for dof in scene.model.dof_names() {
             super::file_name_part(dof, "DOF")?;
         }
-        super::prepare_out(dir)?;
+        let reported = hbal::analysis::reported_dofs(&scene.model, opts.dofs)
+            .map_err(|e| super::failure(e, &scene.file))?;
+        let names = scene.model.dof_names();
+        super::prepare_out(
+            dir,
+            &super::sweep_files(reported.iter().map(|&i| &names[i])),
+        )?;
     }
     let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
     let start = start.zip(opts.start).map(|(s, file)| SweepStart {
@@ -81,7 +88,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         super::sweep_text::print(&scene, &analysis, opts.out.is_some());
     }
     if let Some(dir) = opts.out {
-        super::sweep_files::write(dir, &scene, &analysis)?;
+        super::sweep_files::write(dir, &scene, &analysis)
+            .with_context(|| format!("--out: cannot write into {}", dir.display()))?;
     }
     report_failures(&analysis);
     Ok(analysis.exit_code())

@@ -289,3 +289,65 @@ loads = [{ dof = "x", order = 1, cos = 0.1 }]
     let out = hbal(&["sweep", &scene, "--to", "0.6", "--no-stability"]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
 }
+
+/// A directory where a subcommand writes a file (harmonics.csv, branch.csv, campbell.svg,
+/// report.html, ...) is bad input found before any work: exit 2, nothing on stdout, the path
+/// named, no other file written.
+#[test]
+fn an_output_file_blocked_by_a_directory_is_refused_before_any_work() {
+    let duffing = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/duffing.toml");
+    let cases: [(&[&str], &str); 7] = [
+        (&["solve", "--json", duffing], "harmonics.csv"),
+        (&["solve", duffing], "not_converged_spectrum.svg"),
+        (
+            &["sweep", "--json", "--to", "1.3", duffing],
+            "branch.csv",
+            duffing,
+        ),
+        (
+            &["sweep", "--to", "1.3", duffing],
+            "frequency_response_x.svg",
+            duffing,
+        ),
+        (&["modes", "--json", duffing], "campbell.svg"),
+        (&["compare", duffing], "residual_histories.svg"),
+        (
+            &["report", TWO_SHAFT, "--to", "7000"],
+            "report.html",
+            TWO_SHAFT,
+        ),
+    ];
+    for (i, (args, blocked)) in cases.iter().enumerate() {
+        let dir = temp_dir(&format!("options_contract_blocked_{i}"));
+        let out_dir = dir.join("out");
+        std::fs::create_dir_all(out_dir.join(blocked)).unwrap();
+        let mut all: Vec<&str> = args.to_vec();
+        all.extend(["--out", out_dir.to_str().unwrap()]);
+        let out = hbal(&all);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            out.stdout.is_empty(),
+            "{args:?} printed {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        assert!(
+            err.contains(&format!("{blocked} is a directory")),
+            "{args:?}: {err}"
+        );
+        let written: Vec<_> = std::fs::read_dir(&out_dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .filter(|n| n != blocked && !["solve", "sweep", "modes"].contains(&n.as_str()))
+            .collect();
+        assert!(written.is_empty(), "{args:?} wrote {written:?}");
+    }
+    // A report's part folder: a file where `solve/` goes.
+    let dir = temp_dir("options_contract_blocked_folder");
+    let out_dir = dir.join("out");
+    std::fs::create_dir_all(&out_dir).unwrap();
+    std::fs::write(out_dir.join("solve"), "").unwrap();
+    let out = hbal(&["report", TWO_SHAFT, "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(!out_dir.join("report.html").exists());
+}
