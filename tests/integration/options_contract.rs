@@ -299,11 +299,7 @@ fn an_output_file_blocked_by_a_directory_is_refused_before_any_work() {
     let cases: [(&[&str], &str); 7] = [
         (&["solve", "--json", duffing], "harmonics.csv"),
         (&["solve", duffing], "not_converged_spectrum.svg"),
-        (
-            &["sweep", "--json", "--to", "1.3", duffing],
-            "branch.csv",
-            duffing,
-        ),
+        (&["sweep", "--json", "--to", "1.3", duffing], "branch.csv"),
         (
             &["sweep", "--to", "1.3", duffing],
             "frequency_response_x.svg",
