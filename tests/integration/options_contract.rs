@@ -303,15 +303,10 @@ fn an_output_file_blocked_by_a_directory_is_refused_before_any_work() {
         (
             &["sweep", "--to", "1.3", duffing],
             "frequency_response_x.svg",
-            duffing,
         ),
         (&["modes", "--json", duffing], "campbell.svg"),
         (&["compare", duffing], "residual_histories.svg"),
-        (
-            &["report", TWO_SHAFT, "--to", "7000"],
-            "report.html",
-            TWO_SHAFT,
-        ),
+        (&["report", TWO_SHAFT, "--to", "7000"], "report.html"),
     ];
     for (i, (args, blocked)) in cases.iter().enumerate() {
         let dir = temp_dir(&format!("options_contract_blocked_{i}"));
