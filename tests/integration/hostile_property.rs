@@ -1,5 +1,7 @@
 //! Property-based test of hostile input (issue 13): the example scenes, mutated at random, never
-//! make `hbal check`, `hbal solve --json` or `hbal solve --out` panic, abort, exceed the time and memory limits, print
+//! make `hbal check`, `hbal solve --json`, `hbal solve --out` or one more subcommand chosen at
+//! random (`sweep`, `sweep --parameter`, `modes`, `compare`, `report`; issue 32) panic, abort,
+//! exceed the time and memory limits, print
 //! a non-finite number (`null`), or give an exit code that contradicts its JSON (see
 //! `common/hostile.rs` for the judgement).
 //!
@@ -15,7 +17,7 @@
 
 use crate::common::hostile;
 
-use hostile::{judge, run_limited, write, Breach};
+use hostile::{judge_document, run_limited, write, Breach, Document};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
 use std::collections::BTreeMap;
@@ -209,6 +211,62 @@ struct Tally {
     slowest_case: String,
 }
 
+/// The speed of a scene in its unit (1 where it has none).
+fn speed_of(doc: &toml::Value) -> f64 {
+    let fundamental = doc.get("fundamental");
+    ["rpm", "hz", "rad_s"]
+        .iter()
+        .find_map(|u| {
+            fundamental
+                .and_then(|f| f.get(*u))
+                .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+        })
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .unwrap_or(1.0)
+}
+
+/// The arguments of subcommand `which` on `file` (a short sweep to `to`, a parameter sweep of
+/// the first load's cosine, the modes, the comparison, a report) and the document it prints.
+fn other_command<'a>(
+    which: &str,
+    file: &'a str,
+    to: &'a str,
+    out: &'a str,
+) -> (Vec<&'a str>, Document) {
+    let short = ["--max-points", "6"];
+    match which {
+        "sweep" => (
+            [&["sweep", "--json", file, "--to", to][..], &short].concat(),
+            Document::Sweep,
+        ),
+        "parameter" => (
+            vec![
+                "sweep",
+                "--json",
+                file,
+                "--parameter",
+                "loads[0].cos",
+                "--from",
+                "0",
+                "--to",
+                "1",
+                "--points",
+                "3",
+            ],
+            Document::Sweep,
+        ),
+        "modes" => (vec!["modes", "--json", file], Document::Modes),
+        "compare" => (
+            vec!["compare", "--json", file, "--method", "newton"],
+            Document::Compare,
+        ),
+        _ => (
+            vec!["report", file, "--to", to, "--out", out],
+            Document::None,
+        ),
+    }
+}
+
 #[test]
 fn mutated_scenes_keep_the_exit_code_contract() {
     let scenes = scenes();
@@ -230,10 +288,13 @@ fn mutated_scenes_keep_the_exit_code_contract() {
         ..Config::default()
     });
     let methods = prop::sample::select(vec!["", "fixed_point", "newton", "broyden", "anderson"]);
+    // One more subcommand per case, so that every one meets mutated scenes.
+    let others = prop::sample::select(vec!["sweep", "parameter", "modes", "compare", "report"]);
     let strategy = (
         0..scenes.len(),
         prop::collection::vec(mutation(), 1..=4),
         methods,
+        others,
     );
     // A time budget for the long run: later cases are skipped.
     let budget = std::env::var("HOSTILE_SECONDS")
@@ -242,7 +303,7 @@ fn mutated_scenes_keep_the_exit_code_contract() {
         .map(std::time::Duration::from_secs_f64);
     let started = std::time::Instant::now();
     let tally = Mutex::new(Tally::default());
-    let result = runner.run(&strategy, |(index, mutations, method)| {
+    let result = runner.run(&strategy, |(index, mutations, method, other)| {
         if budget.is_some_and(|b| started.elapsed() > b) {
             return Ok(());
         }
@@ -265,20 +326,25 @@ fn mutated_scenes_keep_the_exit_code_contract() {
             .and_then(|n| n.to_str())
             .unwrap_or("scene.toml");
         let file = write(&dir, name, &text);
-        let mut commands = vec![(vec!["check", file.as_str()], false)];
+        let mut commands = vec![(vec!["check", file.as_str()], Document::None)];
         let mut solve = vec!["solve", "--json", file.as_str()];
         if !method.is_empty() {
             solve.extend(["--method", method]);
         }
-        commands.push((solve, true));
+        commands.push((solve, Document::Solve));
         // With --out: the CSV files and plots of whatever solved (a static or odd solution
         // must not turn into a plot error).
         let out_dir = dir.join("out");
         let out_dir = out_dir.to_str().unwrap_or("out");
-        commands.push((vec!["solve", file.as_str(), "--out", out_dir], false));
+        commands.push((
+            vec!["solve", file.as_str(), "--out", out_dir],
+            Document::None,
+        ));
+        let to = format!("{}", 1.05 * speed_of(&doc));
+        commands.push(other_command(other, file.as_str(), &to, out_dir));
         let mut t = tally.lock().expect("tally");
         t.cases += 1;
-        for (args, json) in commands {
+        for (args, document) in commands {
             let run = run_limited(&args);
             t.runs += 1;
             *t.codes.entry(run.code.unwrap_or(-1)).or_default() += 1;
@@ -290,7 +356,7 @@ fn mutated_scenes_keep_the_exit_code_contract() {
                     path.display()
                 );
             }
-            if let Err((breach, what)) = judge(&run, json) {
+            if let Err((breach, what)) = judge_document(&run, document) {
                 *t.breaches.entry(format!("{breach:?}")).or_default() += 1;
                 return Err(TestCaseError::fail(format!(
                     "{breach:?}: hbal {} ({} with {mutations:?}): {what}\nscene:\n{text}",

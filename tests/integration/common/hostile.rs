@@ -91,7 +91,7 @@ pub enum Breach {
 }
 
 /// Keys whose value may be `null` by the documented schema (docs/scenes.md).
-const NULLABLE: [&str; 12] = [
+const NULLABLE: [&str; 33] = [
     "auto_harmonics",
     "error_estimate",
     "found_by",
@@ -104,10 +104,63 @@ const NULLABLE: [&str; 12] = [
     "stopped",
     "worst_force",
     "worst_quantity",
+    // A sweep's points and branches: what a point has only with its stability or estimate.
+    "stable",
+    "fold_speed",
+    "bifurcation",
+    "bifurcation_speed",
+    "error_estimate_harmonics",
+    "multipliers",
+    "multipliers_abs",
+    "neutral",
+    "orbit_correction",
+    "polished",
+    "stability_orbit",
+    "orbit_difference",
+    "orbit_distance",
+    "turn_evidence",
+    "from_speed",
+    "from_omega_rad_s",
+    "side",
+    "parent_point",
+    // The modes' bounds where a mode has none; compare's quantity where it was not measured.
+    "lower_hz",
+    "upper_hz",
+    "worst_quantity_vs_time_domain",
 ];
 
 /// Judges a run of `hbal check` (`json = false`) or `hbal solve --json` (`json = true`).
+/// What a run prints on stdout, and so how its exit code is judged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Document {
+    /// Nothing to judge (text, files).
+    None,
+    /// `hbal solve --json`: converged, stability, automatic harmonics.
+    Solve,
+    /// `hbal sweep --json` (speed or parameter): `reached`.
+    Sweep,
+    /// `hbal modes --json`: `converged`.
+    Modes,
+    /// `hbal compare --json`: some method converged.
+    Compare,
+}
+
+/// [`judge_document`] of `hbal solve --json` (`json`) or of a run without a document.
 pub fn judge(run: &Run, json: bool) -> Result<(), (Breach, String)> {
+    judge_document(
+        run,
+        if json {
+            Document::Solve
+        } else {
+            Document::None
+        },
+    )
+}
+
+/// Judges `run`, which printed `document`: no panic, abort, timeout, exit code outside 0..=2,
+/// non-finite number, or exit code its document contradicts.
+pub fn judge_document(run: &Run, document: Document) -> Result<(), (Breach, String)> {
+    let json = document != Document::None;
     let fail = |b: Breach, what: String| Err((b, format!("{what}\nstderr: {}", run.stderr)));
     if run.timed_out {
         return fail(
@@ -145,6 +198,31 @@ pub fn judge(run: &Run, json: bool) -> Result<(), (Breach, String)> {
     };
     if let Some(path) = null_number(&doc, "") {
         return fail(Breach::NonFinite, format!("`null` at {path}"));
+    }
+    if document != Document::Solve {
+        let expected = match document {
+            Document::Sweep => doc["reached"].as_bool().map(|r| if r { 0 } else { 1 }),
+            Document::Modes => doc["converged"].as_bool().map(|c| if c { 0 } else { 1 }),
+            _ => doc["methods"].as_array().map(|m| {
+                let any = m.iter().any(|m| m["converged"] == true);
+                if any {
+                    0
+                } else {
+                    1
+                }
+            }),
+        };
+        return match expected {
+            Some(e) if e == code => Ok(()),
+            Some(e) => fail(
+                Breach::Inconsistent,
+                format!("exit code {code}, but the JSON says {e}"),
+            ),
+            None => fail(
+                Breach::Inconsistent,
+                "the JSON lacks its verdict field".into(),
+            ),
+        };
     }
     let converged = doc["converged"].as_bool();
     let stability_failed = doc["stability"].get("error").is_some();
