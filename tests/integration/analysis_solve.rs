@@ -79,3 +79,59 @@ fn the_two_shaft_analysis_reads_as_typed_values() {
     let err = solve(&auto, &settings).unwrap_err();
     assert!(err.to_string().contains("--start needs a fixed H"), "{err}");
 }
+
+/// Automatic harmonics whose second level cannot be refined (an undamped natural frequency at
+/// harmonic 16 of the H = 8 level's 2H reference): the H = 4 level that succeeded is kept and
+/// reported, marked (`stopped` says why, exit 1), with the JSON on stdout.
+#[test]
+fn automatic_harmonics_keep_the_levels_before_one_that_fails() {
+    let scene_text = r#"
+description = "undamped oscillator whose 16th harmonic is resonant"
+dofs = ["x"]
+mass = [[1.0]]
+stiffness = [[256.0]]
+fundamental = { rad_s = 1.0 }
+harmonics = { count = 4, auto = true }
+loads = [{ dof = "x", order = 1, cos = 100.0 }]
+
+[[elements]]
+name = "spring"
+type = "cubic_spring"
+connects = { x = 1.0 }
+k = 0.0
+alpha = 200.0
+"#;
+    let dir = crate::common::cli::temp_dir("analysis_solve_stopped");
+    let path = dir.join("stopped.toml");
+    std::fs::write(&path, scene_text).unwrap();
+    let scene = Scene::load(&path).unwrap();
+    let a = solve(&scene, &SolveSettings::default()).unwrap();
+    let auto = a.auto.as_ref().unwrap();
+    let stopped = auto.stopped.as_deref().unwrap();
+    assert!(
+        stopped.contains("refinement of H = 8") && stopped.contains("singular at harmonic 16"),
+        "{stopped}"
+    );
+    assert!(auto.capped);
+    assert_eq!(auto.levels.len(), 1);
+    assert_eq!(auto.levels[0].harmonics, 4);
+    // The H = 4 level's own estimate against H = 8: about 1e-3, above the tolerance 1e-6.
+    assert!(
+        auto.levels[0].estimate > 1e-4 && auto.levels[0].estimate < 1e-2,
+        "{}",
+        auto.levels[0].estimate
+    );
+    assert!(a.solution.is_converged());
+    assert_eq!(a.solution.basis().harmonics(), 4);
+    assert_eq!(a.exit_code(), 1);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .args(["solve", "--json"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["auto_harmonics"]["stopped"], stopped);
+    assert_eq!(doc["auto_harmonics"]["reached"], false);
+    assert_eq!(doc["harmonics"], 4);
+}
