@@ -66,6 +66,7 @@ pub(crate) fn floquet(
         });
     }
     let basis = solution.basis();
+    check_cost(model, solution)?;
     let map = PeriodMap::new(
         model,
         basis.omega(),
@@ -136,6 +137,41 @@ pub(crate) fn floquet(
         orbit_distance: distance,
         // The multipliers are those of the orbit found (no HB orbit's own to fall back on).
         other_orbit: None,
+    })
+}
+
+/// Most integrator steps the shooting's period maps may take together (tens of seconds for a
+/// small model): beyond, the model is too stiff for their explicit integration.
+const MAX_STEPS: f64 = 2e7;
+
+/// Refuses a model too stiff for the explicit integration of the period map before any of it:
+/// DOP853 is stable for steps up to about `5/λ`, `λ` the fastest rate of the structural part
+/// (Gershgorin's bound `max_i Σ_j |D_ij| / M_ii + (Σ_j |K_ij| / M_ii)^½`), so one period takes
+/// at least `λ νT / 5` steps, and the multipliers alone `2(2n + s) + 1` periods.
+fn check_cost(model: &Model, solution: &Solution) -> Result<()> {
+    let Some(inv_mass) = super::linear_rate::inverse_diagonal_mass(model) else {
+        return Ok(());
+    };
+    let bound = |a| super::linear_rate::gershgorin(a, &inv_mass, &[], &[]);
+    let rate = bound(model.structural_damping()) + bound(model.structural_stiffness()).sqrt();
+    let states: usize = model
+        .elements()
+        .iter()
+        .filter_map(|e| e.law().memory().map(|m| m.state_len()))
+        .sum();
+    let periods = (2 * (2 * model.n_dofs() + states) + 1) as f64;
+    let steps = rate * solution.basis().period() / 5.0 * periods;
+    if steps <= MAX_STEPS {
+        return Ok(());
+    }
+    Err(Error::TooLarge {
+        what: "the stability of laws with memory (shooting on the time-domain model)".into(),
+        size: format!("{steps:.1e} integrator steps"),
+        limit: format!("{MAX_STEPS:.0e}"),
+        advice: format!(
+            "the fastest structural motion decays or turns at {rate:.1e} 1/s, stiff for the explicit integration over periods of {:.2e} s: check the damping and stiffness for a unit mistake, or skip the stability (--no-stability)",
+            solution.basis().period()
+        ),
     })
 }
 

@@ -161,3 +161,29 @@ fn a_free_free_model_with_memory_has_no_multipliers() {
     let err = sol.stability(&model).unwrap_err().to_string();
     assert!(err.contains("free-free") && err.contains("slider"), "{err}");
 }
+
+/// A model too stiff for the explicit integration of its period map (a damping of 4e9 on an
+/// inertia of 0.25: a rate of 1.6e10 1/s, about 1e9 steps over a 0.025 s period's shooting)
+/// is refused at once, naming the cost, instead of integrating for hours (found by the hostile
+/// property test with the clutch damper's damping set to 4e9).
+#[test]
+fn a_model_too_stiff_for_the_period_map_is_refused_at_once() {
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[0.25])
+        .stiffness(DMatrix::from_element(1, 1, 100.0))
+        .damping(DMatrix::from_element(1, 1, 4e9))
+        .element("slider", &[("x", 1.0)], Jenkins::new(50.0, 1.0))
+        .load("x", 1, 1.0, 0.0)
+        .build()
+        .unwrap();
+    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(251.0, 8).unwrap()).unwrap();
+    let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
+    assert!(sol.is_converged());
+    let started = std::time::Instant::now();
+    let e = sol.stability(&model).unwrap_err().to_string();
+    assert!(started.elapsed().as_secs_f64() < 1.0);
+    assert!(
+        e.contains("integrator steps") && e.contains("1.6e10 1/s"),
+        "{e}"
+    );
+}
