@@ -73,10 +73,14 @@ pub(crate) fn floquet(
         basis.subharmonic(),
         options.rtol.min(1e-10),
     )?;
+    let map = Budgeted {
+        map,
+        used: std::cell::Cell::new(0),
+    };
     let hb = super::shooting::hb_start(solution);
     let mut x = hb.clone();
-    x.extend(march(model, solution, map.laws()));
-    let scales = scales(model, solution, map.laws());
+    x.extend(march(model, solution, map.map.laws()));
+    let scales = scales(model, solution, map.map.laws());
     let (mut steps, mut polished) = (0, false);
     let mut best = f64::INFINITY;
     for _ in 0..MAX_NEWTON {
@@ -140,27 +144,57 @@ pub(crate) fn floquet(
     })
 }
 
-/// Most integrator steps the shooting's period maps may take together (tens of seconds for a
-/// small model): beyond, the model is too stiff for their explicit integration.
-const MAX_STEPS: f64 = 2e7;
+/// Most integrator steps the shooting's period maps may take together (about 10 s for a small
+/// model with several laws): beyond, the model is too stiff for their
+/// explicit integration, refused before any of it where the a priori bound exceeds it
+/// ([`check_cost`]) and stopped where the steps taken do ([`Budgeted`]).
+const MAX_STEPS: f64 = 1e6;
+
+/// The period map with the steps taken so far, stopped past [`MAX_STEPS`].
+struct Budgeted<'m> {
+    map: PeriodMap<'m>,
+    used: std::cell::Cell<usize>,
+}
+
+impl Budgeted<'_> {
+    /// [`PeriodMap::apply`], or an error once the steps taken exceed [`MAX_STEPS`].
+    fn apply(&self, x: &[f64]) -> Result<(Vec<f64>, usize)> {
+        let (px, steps) = self.map.apply(x)?;
+        self.used.set(self.used.get() + steps);
+        if self.used.get() as f64 > MAX_STEPS {
+            return Err(Error::TimeIntegration {
+                reason: format!(
+                    "the shooting of laws with memory stopped after {} steps of its period maps (the limit {MAX_STEPS:.0e}): the orbit is too fast or too unstable for their explicit integration; check the damping, stiffness and loads for a unit mistake, or skip the stability (--no-stability)",
+                    self.used.get()
+                ),
+            });
+        }
+        Ok((px, steps))
+    }
+}
 
 /// Refuses a model too stiff for the explicit integration of the period map before any of it:
-/// DOP853 is stable for steps up to about `5/λ`, `λ` the fastest rate of the structural part
-/// (Gershgorin's bound `max_i Σ_j |D_ij| / M_ii + (Σ_j |K_ij| / M_ii)^½`), so one period takes
+/// DOP853 is stable for steps up to about `5/λ`, `λ` the fastest rate of the model along the
+/// orbit (Gershgorin's bound `max_i Σ_j |D_ij| / M_ii + (Σ_j |K_ij| / M_ii)^½` with every
+/// element at its largest tangent `|∂f/∂u|`, `|∂f/∂u̇|` on the HB orbit), so one period takes
 /// at least `λ νT / 5` steps, and the multipliers alone `2(2n + s) + 1` periods.
 fn check_cost(model: &Model, solution: &Solution) -> Result<()> {
     let Some(inv_mass) = super::linear_rate::inverse_diagonal_mass(model) else {
         return Ok(());
     };
-    let bound = |a| super::linear_rate::gershgorin(a, &inv_mass, &[], &[]);
-    let rate = bound(model.structural_damping()) + bound(model.structural_stiffness()).sqrt();
+    let (k_top, d_top) = largest_tangents(model, solution);
+    let weights: Vec<&[(usize, f64)]> = model.elements().iter().map(|e| e.weights()).collect();
+    let bound = |a, top: &[f64]| super::linear_rate::gershgorin(a, &inv_mass, &weights, top);
+    let rate = bound(model.structural_damping(), &d_top)
+        + bound(model.structural_stiffness(), &k_top).sqrt();
     let states: usize = model
         .elements()
         .iter()
         .filter_map(|e| e.law().memory().map(|m| m.state_len()))
         .sum();
     let periods = (2 * (2 * model.n_dofs() + states) + 1) as f64;
-    let steps = rate * solution.basis().period() / 5.0 * periods;
+    let period = solution.basis().period();
+    let steps = rate * period / 5.0 * periods;
     if steps <= MAX_STEPS {
         return Ok(());
     }
@@ -169,10 +203,40 @@ fn check_cost(model: &Model, solution: &Solution) -> Result<()> {
         size: format!("{steps:.1e} integrator steps"),
         limit: format!("{MAX_STEPS:.0e}"),
         advice: format!(
-            "the fastest structural motion decays or turns at {rate:.1e} 1/s, stiff for the explicit integration over periods of {:.2e} s: check the damping and stiffness for a unit mistake, or skip the stability (--no-stability)",
-            solution.basis().period()
+            "the fastest motion along the orbit decays or turns at {rate:.1e} 1/s, stiff for the explicit integration over periods of {period:.2e} s: check the damping, stiffness and loads for a unit mistake, or skip the stability (--no-stability)"
         ),
     })
+}
+
+/// Every element's largest `|∂f/∂u|` and `|∂f/∂u̇|` on the HB orbit (at its samples).
+fn largest_tangents(model: &Model, solution: &Solution) -> (Vec<f64>, Vec<f64>) {
+    let basis = solution.basis();
+    let nu = basis.subharmonic() as f64;
+    let samples = basis.samples();
+    let along = |w: &[(usize, f64)], theta: f64| {
+        let u = w
+            .iter()
+            .map(|&(i, c)| c * solution.displacement(i, theta))
+            .sum::<f64>();
+        let du = w
+            .iter()
+            .map(|&(i, c)| c * solution.velocity(i, theta))
+            .sum::<f64>();
+        (u, du)
+    };
+    model
+        .elements()
+        .iter()
+        .map(|e| {
+            (0..samples).fold((0.0f64, 0.0f64), |(k, d), j| {
+                let theta = basis.theta(j);
+                let (u, du) = along(e.weights(), theta);
+                let (dk, dd) = e.law().derivatives(nu * theta, u, du);
+                let finite = |x: f64| if x.is_finite() { x.abs() } else { 0.0 };
+                (k.max(finite(dk)), d.max(finite(dd)))
+            })
+        })
+        .unzip()
 }
 
 /// `true` if the shooting of laws with memory applies to `model` (up to [`MAX_DOFS`] DOFs, no rigid-body mode:
@@ -184,7 +248,7 @@ pub fn available(model: &Model) -> bool {
 /// `∂P/∂x` at `x` by forward differences from `P(x) = px`, or by central ones without it; and
 /// the integrator's steps.
 fn jacobian(
-    map: &PeriodMap,
+    map: &Budgeted,
     x: &[f64],
     px: Option<&[f64]>,
     scales: &[f64],
