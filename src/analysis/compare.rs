@@ -153,6 +153,7 @@ fn reference(
             (q, v)
         });
     let from_orbit = start_state.is_some();
+    check_reference_cost(scene, basis, solved)?;
     let td = TimeSimulation {
         rtol: 1e-10,
         steady_tolerance: 1e-8,
@@ -160,6 +161,10 @@ fn reference(
         // 600 rpm (the ringing of its stiffness jumps near harmonic 77), 4096 3e-9.
         samples: (4 * basis.harmonics() + 4).next_power_of_two().max(4096),
         initial: start_state,
+        // Started on the HB orbit it settles in tens of periods; a bounded effort from rest
+        // (a scene whose contact never closes drifts for 1e5): then marked not converged.
+        max_periods: MAX_REFERENCE_PERIODS,
+        max_steps: Some(MAX_REFERENCE_STEPS),
         ..TimeSimulation::default()
     }
     .run(&scene.model, basis.omega())
@@ -170,6 +175,45 @@ fn reference(
         other => other,
     })?;
     Ok((td, from_orbit))
+}
+
+/// Most periods of the time-domain reference.
+const MAX_REFERENCE_PERIODS: usize = 5000;
+
+/// Most integrator steps of the time-domain reference (about a minute for a small model).
+const MAX_REFERENCE_STEPS: usize = 2_000_000;
+
+/// Most integrator steps per period the time-domain reference may need by its stiffness.
+const MAX_STEPS_PER_PERIOD: f64 = 1e5;
+
+/// Refuses a time-domain reference too stiff for its explicit integration before any of it:
+/// DOP853's stable step is about `5/λ`, `λ` the fastest rate along the first solution's orbit
+/// (Gershgorin's bound with every element at its largest tangent).
+fn check_reference_cost(
+    scene: &Scene,
+    basis: &HarmonicBasis,
+    solved: &[(String, f64, Solution)],
+) -> Result<()> {
+    let Some(first) = solved
+        .iter()
+        .find(|s| s.2.is_converged())
+        .or(solved.first())
+    else {
+        return Ok(());
+    };
+    let Some(rate) = crate::stability::fastest_rate(&scene.model, &first.2) else {
+        return Ok(());
+    };
+    let steps = rate * basis.period() / 5.0;
+    if steps <= MAX_STEPS_PER_PERIOD {
+        return Ok(());
+    }
+    Err(Error::TimeIntegration {
+        reason: format!(
+            "the time-domain reference would need at least {steps:.1e} steps per period (the limit {MAX_STEPS_PER_PERIOD:.0e}): the fastest motion decays or turns at {rate:.1e} 1/s over a period of {:.2e} s; check the damping, stiffness and loads for a unit mistake",
+            basis.period()
+        ),
+    })
 }
 
 /// One method's solution measured against the time domain `td`.

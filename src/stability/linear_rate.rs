@@ -149,6 +149,51 @@ pub(crate) fn gershgorin(
         .fold(0.0, f64::max)
 }
 
+/// Gershgorin's bound on the fastest rate (1/s) of `model` linearised along `solution`,
+/// `max_i Σ_j |D_ij| / M_ii + (Σ_j |K_ij| / M_ii)^½` with every element at its largest
+/// tangent `|∂f/∂u|`, `|∂f/∂u̇|` on the orbit's samples: an explicit integrator's stable step
+/// is at most a few times its inverse. `None` for a mass matrix that is not diagonal.
+pub(crate) fn fastest_rate(model: &Model, solution: &crate::Solution) -> Option<f64> {
+    let inv_mass = inverse_diagonal_mass(model)?;
+    let (k_top, d_top) = largest_tangents(model, solution);
+    let weights: Vec<&[(usize, f64)]> = model.elements().iter().map(|e| e.weights()).collect();
+    let bound = |a, top: &[f64]| gershgorin(a, &inv_mass, &weights, top);
+    Some(
+        bound(model.structural_damping(), &d_top)
+            + bound(model.structural_stiffness(), &k_top).sqrt(),
+    )
+}
+
+/// Every element's largest `|∂f/∂u|` and `|∂f/∂u̇|` on `solution` (at its samples).
+fn largest_tangents(model: &Model, solution: &crate::Solution) -> (Vec<f64>, Vec<f64>) {
+    let basis = solution.basis();
+    let nu = basis.subharmonic() as f64;
+    let along = |w: &[(usize, f64)], theta: f64| {
+        let u = w
+            .iter()
+            .map(|&(i, c)| c * solution.displacement(i, theta))
+            .sum::<f64>();
+        let du = w
+            .iter()
+            .map(|&(i, c)| c * solution.velocity(i, theta))
+            .sum::<f64>();
+        (u, du)
+    };
+    let finite = |x: f64| if x.is_finite() { x.abs() } else { 0.0 };
+    model
+        .elements()
+        .iter()
+        .map(|e| {
+            (0..basis.samples()).fold((0.0f64, 0.0f64), |(k, d), j| {
+                let theta = basis.theta(j);
+                let (u, du) = along(e.weights(), theta);
+                let (dk, dd) = e.law().derivatives(nu * theta, u, du);
+                (k.max(finite(dk)), d.max(finite(dd)))
+            })
+        })
+        .unzip()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

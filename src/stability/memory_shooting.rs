@@ -179,14 +179,9 @@ impl Budgeted<'_> {
 /// element at its largest tangent `|∂f/∂u|`, `|∂f/∂u̇|` on the HB orbit), so one period takes
 /// at least `λ νT / 5` steps, and the multipliers alone `2(2n + s) + 1` periods.
 fn check_cost(model: &Model, solution: &Solution) -> Result<()> {
-    let Some(inv_mass) = super::linear_rate::inverse_diagonal_mass(model) else {
+    let Some(rate) = super::linear_rate::fastest_rate(model, solution) else {
         return Ok(());
     };
-    let (k_top, d_top) = largest_tangents(model, solution);
-    let weights: Vec<&[(usize, f64)]> = model.elements().iter().map(|e| e.weights()).collect();
-    let bound = |a, top: &[f64]| super::linear_rate::gershgorin(a, &inv_mass, &weights, top);
-    let rate = bound(model.structural_damping(), &d_top)
-        + bound(model.structural_stiffness(), &k_top).sqrt();
     let states: usize = model
         .elements()
         .iter()
@@ -206,37 +201,6 @@ fn check_cost(model: &Model, solution: &Solution) -> Result<()> {
             "the fastest motion along the orbit decays or turns at {rate:.1e} 1/s, stiff for the explicit integration over periods of {period:.2e} s: check the damping, stiffness and loads for a unit mistake, or skip the stability (--no-stability)"
         ),
     })
-}
-
-/// Every element's largest `|∂f/∂u|` and `|∂f/∂u̇|` on the HB orbit (at its samples).
-fn largest_tangents(model: &Model, solution: &Solution) -> (Vec<f64>, Vec<f64>) {
-    let basis = solution.basis();
-    let nu = basis.subharmonic() as f64;
-    let samples = basis.samples();
-    let along = |w: &[(usize, f64)], theta: f64| {
-        let u = w
-            .iter()
-            .map(|&(i, c)| c * solution.displacement(i, theta))
-            .sum::<f64>();
-        let du = w
-            .iter()
-            .map(|&(i, c)| c * solution.velocity(i, theta))
-            .sum::<f64>();
-        (u, du)
-    };
-    model
-        .elements()
-        .iter()
-        .map(|e| {
-            (0..samples).fold((0.0f64, 0.0f64), |(k, d), j| {
-                let theta = basis.theta(j);
-                let (u, du) = along(e.weights(), theta);
-                let (dk, dd) = e.law().derivatives(nu * theta, u, du);
-                let finite = |x: f64| if x.is_finite() { x.abs() } else { 0.0 };
-                (k.max(finite(dk)), d.max(finite(dd)))
-            })
-        })
-        .unzip()
 }
 
 /// `true` if the shooting of laws with memory applies to `model` (up to [`MAX_DOFS`] DOFs, no rigid-body mode:

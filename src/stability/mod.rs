@@ -91,6 +91,7 @@ mod orbit_identity;
 pub use orbit_identity::{orbit_distance, OTHER_ORBIT_DISTANCE};
 mod krylov_floquet;
 mod linear_rate;
+pub(crate) use linear_rate::fastest_rate;
 mod pieces;
 mod pipeline;
 mod propagator;

@@ -53,6 +53,9 @@ pub struct TimeSimulation {
     pub max_step: Option<f64>,
     /// Initial `(q, q̇)`; default rest.
     pub initial: Option<(Vec<f64>, Vec<f64>)>,
+    /// Give up once the integrator has taken this many steps (checked after every period;
+    /// [`TimeStop::StepLimit`]). Default none.
+    pub max_steps: Option<usize>,
 }
 
 impl Default for TimeSimulation {
@@ -65,6 +68,7 @@ impl Default for TimeSimulation {
             samples: 1024,
             max_step: None,
             initial: None,
+            max_steps: None,
         }
     }
 }
@@ -80,6 +84,8 @@ pub enum TimeStop {
     /// The difference stopped falling above the steady tolerance (`stall_periods` without a new
     /// best): tighten `rtol` or loosen `steady_tolerance`.
     Stalled,
+    /// `max_steps` reached before the difference met the steady tolerance.
+    StepLimit,
 }
 
 /// The periodic response found by time integration.
@@ -182,6 +188,10 @@ impl TimeSimulation {
             }
             if diff < self.steady_tolerance {
                 stop = TimeStop::Steady;
+                break;
+            }
+            if self.max_steps.is_some_and(|m| steps >= m) {
+                stop = TimeStop::StepLimit;
                 break;
             }
             if diff < best {
