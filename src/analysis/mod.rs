@@ -62,10 +62,11 @@ pub use observer::{Observer, Silent};
 pub use options::{check, check_speed, check_sweep_start};
 pub use output_choice::{reported_dofs, shown_output, Shown, ALL_DOFS_UP_TO};
 pub use parameter_sweep::{
-    parameter_sweep, ParameterAuto, ParameterSweepAnalysis, ParameterSweepSettings,
+    check_parameter_sweep, parameter_sweep, ParameterAuto, ParameterSweepAnalysis,
+    ParameterSweepSettings,
 };
 pub use solve::{solve, AutoRecord, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};
-pub use sweep::{sweep, SweepAnalysis};
+pub use sweep::{check_sweep, sweep, SweepAnalysis};
 pub use sweep_outcome::SweepNote;
 pub use sweep_record::SCHEMA_VERSION;
 pub use sweep_settings::{SweepSettings, SweepStart};

@@ -103,12 +103,19 @@ pub fn modes(scene: &Scene, settings: &ModesSettings) -> Result<ModesAnalysis> {
         reason,
     };
     if to <= from {
-        let reason = format!("{to}: need 0 <= from < to (in {})", scene.speed_unit);
-        return Err(bad("--to", reason));
+        let reason = format!(
+            "{from} --to {to}: need 0 <= from < to (in {})",
+            scene.speed_unit
+        );
+        return Err(bad("--from", reason));
     }
     let max_hz = match settings.max_hz {
         Some(f) if !(f.is_finite() && f > 0.0 && f <= crate::error::MAX_MAGNITUDE) => {
-            return Err(bad("--max-hz", format!("must be finite and > 0, got {f}")))
+            let got = crate::report::significant(f, 6);
+            return Err(bad(
+                "--max-hz",
+                format!("must be finite, > 0 and at most 1e100, got {got}"),
+            ));
         }
         Some(f) => f,
         None if scene.model.n_dofs() <= 300 => f64::INFINITY,

@@ -129,6 +129,20 @@ pub fn parameter_sweep(
     })
 }
 
+/// Checks `settings` against the scene `document` as [`parameter_sweep()`] does before any
+/// work (a front end that prepares output files calls it first).
+///
+/// # Errors
+/// What [`parameter_sweep()`] refuses as bad input.
+pub fn check_parameter_sweep(
+    document: &Value,
+    file: &str,
+    settings: &ParameterSweepSettings,
+) -> Result<()> {
+    let first = check(document, file, settings)?;
+    reported_dofs(&first.model, settings.dofs.as_deref()).map(|_| ())
+}
+
 /// The evenly spaced values.
 fn values(settings: &ParameterSweepSettings) -> Vec<f64> {
     let (from, to, n) = (settings.from, settings.to, settings.points);

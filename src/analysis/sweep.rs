@@ -97,6 +97,7 @@ pub fn sweep(
             harmonics: basis.harmonics(),
             estimate: auto.control.of(&a.estimate),
             capped: a.capped,
+            from: plan.from,
             raised,
         });
         if raised {
@@ -107,7 +108,7 @@ pub fn sweep(
     let started = Instant::now();
     let to = settings.to * per;
     let mut progress = |f: f64| observer.progress(f);
-    let branch = match &auto_start {
+    let mut branch = match &auto_start {
         Some((auto, q)) => {
             let segments = continuation
                 .run_auto(&scene.model, basis, to, Some(q), *auto, &mut progress)
@@ -137,9 +138,15 @@ pub fn sweep(
             plan.from.min(settings.to) * per,
             plan.from.max(settings.to) * per,
         );
-        continuation
+        let switched = continuation
             .switch_branches(&scene.model, basis, &branch, lo, hi)
-            .map_err(Error::after_check)?
+            .map_err(Error::after_check)?;
+        // Cancelled while switching: the bifurcations after it were not followed.
+        if settings.cancel.is_cancelled() {
+            let parameter = branch.points.last().map_or(0.0, |p| p.omega);
+            branch.stop = BranchStop::Cancelled { parameter };
+        }
+        switched
     } else {
         Vec::new()
     };
@@ -165,6 +172,15 @@ pub fn sweep(
         stability_unavailable: stability_unavailable(scene, settings),
         seconds,
     })
+}
+
+/// Checks `settings` against `scene` as [`sweep()`] does before any work (a front end that
+/// prepares output files calls it first).
+///
+/// # Errors
+/// What [`sweep()`] refuses as bad input.
+pub fn check_sweep(scene: &Scene, settings: &SweepSettings) -> Result<()> {
+    plan(scene, settings).map(|_| ())
 }
 
 /// The options of `settings` checked against `scene`, the first speed and the notes on them.

@@ -32,6 +32,8 @@ pub enum SweepNote {
         estimate: f64,
         /// Above the tolerance at the cap.
         capped: bool,
+        /// The first speed (the scene's unit), where H was chosen.
+        from: f64,
         /// Raised along the branch where a point exceeds the tolerance (else kept).
         raised: bool,
     },
@@ -106,8 +108,8 @@ impl SweepNote {
             SweepNote::StartSpeed { label, computed_at, from } => format!(
                 "--start {label} was computed at {computed_at} {unit}; the sweep starts at {from} {unit}"
             ),
-            SweepNote::AutoHarmonics { settings, harmonics, estimate, capped, raised } => format!(
-                "harmonics: auto, tolerance {:.0e}{}: H = {harmonics} (error estimate {estimate:.1e} at the first speed{}), {}",
+            SweepNote::AutoHarmonics { settings, harmonics, estimate, capped, from, raised } => format!(
+                "harmonics: auto, tolerance {:.0e}{}: H = {harmonics} (error estimate {estimate:.1e} at {from} {unit}{}), {}",
                 settings.tolerance,
                 settings.control.pick("", " on the harmonics 0..H"),
                 if *capped { ", above the tolerance at the cap" } else { "" },

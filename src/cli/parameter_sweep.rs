@@ -47,6 +47,8 @@ pub(crate) fn parameter_sweep(
         dofs: opts.dofs.map(str::to_string),
         cancel: Default::default(),
     };
+    hbal::analysis::check_parameter_sweep(&doc, &file, &settings)
+        .map_err(|e| super::failure(e, &file))?;
     if let Some(dir) = opts.out {
         // The DOF names of the first value make the file names.
         let mut first = doc.clone();

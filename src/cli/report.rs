@@ -41,7 +41,7 @@ impl<T> Part<T> {
         match analysis.and_then(|a| write(&a).map(|()| a)) {
             Ok(a) => {
                 let code = code(&a);
-                let error = (code != 0).then(|| failed.to_string());
+                let error = (code != 0 && !failed.is_empty()).then(|| failed.to_string());
                 Part {
                     result: Some(a),
                     error,
@@ -150,11 +150,11 @@ fn solve_part(scene: &Scene, args: &SolverArgs, opts: &ReportOptions) -> Part<So
     let analysis =
         hbal::analysis::solve(scene, &settings).map_err(|e| super::failure(e, &scene.file));
     let dir = opts.out.join("solve");
-    let failed = format!(
-        "{}: the solve did not converge or its stability failed",
-        scene.file
-    );
-    Part::run(analysis, SolveAnalysis::exit_code, &failed, |a| {
+    // Its notes and failures as `hbal solve` prints them.
+    if let Ok(a) = &analysis {
+        super::solve::print_messages(scene, a, None);
+    }
+    Part::run(analysis, SolveAnalysis::exit_code, "", |a| {
         super::solve::write_files(scene, a, &dir, true)
     })
 }
@@ -177,11 +177,11 @@ fn sweep_part(
     let analysis = hbal::analysis::sweep(scene, &settings, &mut hbal::analysis::Silent)
         .map_err(|e| super::failure(e, &scene.file));
     let dir = opts.out.join("sweep");
-    let failed = match &analysis {
-        Ok(a) => format!("{}: the branch stopped: {}", scene.file, a.branch.stop),
-        Err(_) => String::new(),
-    };
-    Part::run(analysis, SweepAnalysis::exit_code, &failed, |a| {
+    // Its notes and failures as `hbal sweep` prints them.
+    if let Ok(a) = &analysis {
+        super::sweep::print_messages(a);
+    }
+    Part::run(analysis, SweepAnalysis::exit_code, "", |a| {
         Ok(super::sweep_files::write(&dir, scene, a)?)
     })
 }

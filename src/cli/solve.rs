@@ -43,34 +43,15 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         formulation: args.formulation,
     };
     let a = hbal::analysis::solve(&scene, &settings).map_err(|e| super::failure(e, &scene.file))?;
-    for note in &a.notes {
-        match (note, opts.start) {
-            (SolveNote::StartUnused, Some(file)) => eprintln!(
-                "note: --start {} is not used: the exact piecewise solution needs no start",
-                file.display()
-            ),
-            _ => eprintln!("note: {}: {note}", scene.file),
-        }
-    }
     if as_json {
         say!("{}", a.to_json());
     } else {
         super::solve_text::print(&scene, &a, opts.stability);
     }
-    match &a.stability {
-        StabilityOutcome::Computed(f) if !f.is_stable() => eprintln!(
-            "warning: the converged orbit is unstable (max |μ| = {:.6}): a time simulation would leave it",
-            f.max_abs()
-        ),
-        StabilityOutcome::Failed(e) => {
-            eprintln!("error: {}: stability computation failed: {e}", scene.file)
-        }
-        _ => {}
-    }
     if let Some(dir) = opts.out {
         write_files(&scene, &a, dir, as_json)?;
     }
-    report_failures(&scene, &a);
+    print_messages(&scene, &a, opts.start);
     Ok(a.exit_code())
 }
 
@@ -182,4 +163,29 @@ fn report_failures(scene: &Scene, a: &SolveAnalysis) {
             levels.last().map_or(0, |l| l.harmonics),
         );
     }
+}
+
+/// The notes, warnings and failures of `a` (a solve of `scene`, from the start file `start`)
+/// on stderr.
+pub(crate) fn print_messages(scene: &Scene, a: &SolveAnalysis, start: Option<&Path>) {
+    for note in &a.notes {
+        match (note, start) {
+            (SolveNote::StartUnused, Some(file)) => eprintln!(
+                "note: --start {} is not used: the exact piecewise solution needs no start",
+                file.display()
+            ),
+            _ => eprintln!("note: {}: {note}", scene.file),
+        }
+    }
+    match &a.stability {
+        StabilityOutcome::Computed(f) if !f.is_stable() => eprintln!(
+            "warning: the converged orbit is unstable (max |μ| = {:.6}): a time simulation would leave it",
+            f.max_abs()
+        ),
+        StabilityOutcome::Failed(e) => {
+            eprintln!("error: {}: stability computation failed: {e}", scene.file)
+        }
+        _ => {}
+    }
+    report_failures(scene, a);
 }

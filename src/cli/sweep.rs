@@ -56,6 +56,14 @@ impl SweepOptions<'_> {
 pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
     let as_json = opts.json;
     let scene = load(path, args)?;
+    let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
+    let start = start.zip(opts.start).map(|(s, file)| SweepStart {
+        harmonics: s.harmonics,
+        omega: s.omega,
+        label: file.display().to_string(),
+    });
+    let settings = opts.settings(args, start);
+    hbal::analysis::check_sweep(&scene, &settings).map_err(|e| super::failure(e, &scene.file))?;
     if let Some(dir) = opts.out {
         for dof in scene.model.dof_names() {
             super::file_name_part(dof, "DOF")?;
@@ -68,20 +76,10 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
             &super::sweep_files(reported.iter().map(|&i| &names[i])),
         )?;
     }
-    let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
-    let start = start.zip(opts.start).map(|(s, file)| SweepStart {
-        harmonics: s.harmonics,
-        omega: s.omega,
-        label: file.display().to_string(),
-    });
-    let settings = opts.settings(args, start);
     let bar = super::progress::Progress::new("sweep", as_json);
     let analysis = hbal::analysis::sweep(&scene, &settings, &mut &bar)
         .map_err(|e| super::failure(e, &scene.file))?;
     bar.finish();
-    for note in &analysis.notes {
-        eprintln!("note: {}", note.describe(&analysis.unit));
-    }
     if as_json {
         say!("{}", analysis.to_json());
     } else {
@@ -91,13 +89,16 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         super::sweep_files::write(dir, &scene, &analysis)
             .with_context(|| format!("--out: cannot write into {}", dir.display()))?;
     }
-    report_failures(&analysis);
+    print_messages(&analysis);
     Ok(analysis.exit_code())
 }
 
-/// The failures and warnings that mark the sweep, on stderr.
-fn report_failures(a: &SweepAnalysis) {
+/// The notes of the sweep, and the failures and warnings that mark it, on stderr.
+pub(crate) fn print_messages(a: &SweepAnalysis) {
     let (file, unit) = (&a.file, &a.unit);
+    for note in &a.notes {
+        eprintln!("note: {}", note.describe(unit));
+    }
     if a.branch.stop != hbal::continuation::BranchStop::Reached {
         eprintln!("error: {file}: the branch stopped: {}", a.branch.stop);
     }

@@ -335,11 +335,11 @@ impl Continuation {
                 return Some(BranchStop::StabilityFailed { omega, reason });
             }
             progress(((omega - from) / (to - from)).clamp(0.0, 1.0));
-            if self.cancel.is_cancelled() {
-                return Some(BranchStop::Cancelled { parameter: omega });
-            }
             if landed || (omega - to) * direction >= 0.0 {
                 return Some(BranchStop::Reached);
+            }
+            if self.cancel.is_cancelled() {
+                return Some(BranchStop::Cancelled { parameter: omega });
             }
             if rejoined {
                 return Some(BranchStop::Rejoined { omega });

@@ -39,6 +39,11 @@ impl Continuation {
         let direction = (to - basis.omega()).signum();
         loop {
             let branch = tracer.run_from(model, basis, to, start.as_deref(), &mut progress)?;
+            // Cancelled: no refinement after it, the segment's points kept as they are.
+            if matches!(branch.stop, BranchStop::Cancelled { .. }) {
+                segments.push(branch);
+                return Ok(segments);
+            }
             let capped = 2 * basis.harmonics() > auto.max_harmonics;
             let error = |i: usize| {
                 let p = &branch.points[i];

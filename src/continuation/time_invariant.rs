@@ -134,7 +134,7 @@ impl Continuation {
                 return Ok(Some(branch));
             }
             progress(((last.omega - from) / (to - from)).clamp(0.0, 1.0));
-            if self.cancel.is_cancelled() {
+            if self.cancel.is_cancelled() && (to - last.omega) * direction > 0.0 {
                 branch.stop = BranchStop::Cancelled {
                     parameter: last.omega,
                 };

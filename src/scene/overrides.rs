@@ -110,7 +110,7 @@ impl Overrides {
             let option = option.to_string();
             move |e: Error| Error::InvalidOptions {
                 option: option.clone(),
-                reason: format!("gives {e}"),
+                reason: format!("is refused: {e}"),
             }
         };
         let mut out = *basis;

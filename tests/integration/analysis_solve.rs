@@ -134,4 +134,19 @@ alpha = 200.0
     assert_eq!(doc["auto_harmonics"]["stopped"], stopped);
     assert_eq!(doc["auto_harmonics"]["reached"], false);
     assert_eq!(doc["harmonics"], 4);
+    // The report says why, as `hbal solve` does (it once said the solve did not converge).
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hbal"))
+        .arg("report")
+        .arg(&path)
+        .arg("--out")
+        .arg(dir.join("report"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("automatic harmonics stopped before the tolerance"),
+        "{err}"
+    );
+    assert!(!err.contains("did not converge"), "{err}");
 }

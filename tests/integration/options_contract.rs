@@ -342,3 +342,48 @@ fn an_output_file_blocked_by_a_directory_is_refused_before_any_work() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(!out_dir.join("report.html").exists());
 }
+
+/// The library's own checks of a sweep (an unknown `--output`, a parameter sweep's `--method`)
+/// run before `--out` is prepared: no directory is left behind.
+#[test]
+fn a_sweep_refused_by_the_library_leaves_no_out_directory() {
+    let duffing = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/duffing.toml");
+    let dir = temp_dir("options_contract_sweep_out");
+    let out_dir = dir.join("out");
+    let out_arg = out_dir.to_str().unwrap();
+    for args in [
+        vec![
+            "sweep", duffing, "--to", "2", "--output", "nope", "--out", out_arg,
+        ],
+        vec![
+            "sweep",
+            duffing,
+            "--parameter",
+            "loads[0].cos",
+            "--from",
+            "0",
+            "--to",
+            "1",
+            "--method",
+            "newton",
+            "--out",
+            out_arg,
+        ],
+        vec![
+            "sweep",
+            duffing,
+            "--parameter",
+            "dofs.count",
+            "--from",
+            "1",
+            "--to",
+            "2",
+            "--out",
+            out_arg,
+        ],
+    ] {
+        let out = hbal(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(!out_dir.exists(), "{args:?} created {}", out_dir.display());
+    }
+}
