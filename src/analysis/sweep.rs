@@ -195,6 +195,12 @@ fn plan(scene: &Scene, settings: &SweepSettings) -> Result<Plan> {
     super::check_speed(scene, "--from", from, false)?;
     super::check_speed(scene, "--to", settings.to, false)?;
     if let Some(s) = &settings.start {
+        if scene.auto.is_some() {
+            return Err(Error::InvalidOptions {
+                option: "--start".into(),
+                reason: "needs a fixed H: give --harmonics N (automatic harmonics start the sweep from their own solve at the first speed)".into(),
+            });
+        }
         super::solve::check_start(scene, &s.harmonics, &s.label)?;
     }
     super::check_sweep_start(scene, from * per, settings.formulation)?;

@@ -179,6 +179,23 @@ fn the_library_refuses_invalid_sweep_options() {
         assert!(e.to_string().contains(message), "{e}");
         assert_eq!(e.exit_code(), 2, "{e}");
     }
+    // Start harmonics with automatic harmonics: refused as the solve refuses them (they were
+    // fed into the automatic H, exit 1 after its solve, or ignored).
+    let mut auto = Scene::load(&path).unwrap();
+    auto.auto = Some(hbal::solve::AutoHarmonics::default());
+    let n = auto.model.n_dofs() * (auto.basis.harmonics() + 1);
+    let start = hbal::analysis::SweepStart {
+        harmonics: vec![num_complex::Complex64::default(); n],
+        omega: None,
+        label: "previous.json".into(),
+    };
+    let settings = SweepSettings {
+        start: Some(start),
+        ..SweepSettings::to(2.0)
+    };
+    let e = sweep(&auto, &settings, &mut Silent).unwrap_err();
+    assert!(e.to_string().contains("--start needs a fixed H"), "{e}");
+    assert_eq!(e.exit_code(), 2);
 }
 
 /// The parameter sweep: the library's result is `hbal sweep --parameter --json`; a field that
