@@ -1,14 +1,14 @@
 //! The monodromy matrix along the HB orbit itself ([`Orbit::Harmonic`](super::Orbit::Harmonic)):
 //! the exponential flow's pieces without integrating the orbit.
 //!
-//! Where every law is affine between its time jumps and kinks ([`exponential`](super::exponential)),
+//! Where every law is affine between its time jumps and kinks ([`exponential`](super::exponential::exp_flow)),
 //! the variational equation `Φ̃' = Ã(t) Φ̃` depends on the orbit only through the piece each
 //! element is in. Along the HB orbit `q_H(t) = Re Σ_k Q_k e^{ikωt}` the element coordinates
 //! `u_e(t) = w_e·q_H(t)` are trigonometric polynomials, so the pieces are known without a
 //! step of integration: a kink `κ` is crossed at a root of `u_e(θ) − κ` (`θ = ωt`), found on
 //! `16H` samples (a power of two, at least 64) and refined by safeguarded Newton with the
 //! analytic derivative. `Φ̃` is then the same product as for an integrated orbit
-//! ([`record`](super::record)): per piece `E_δ₀^m e^{Ãτ}` with `h = m δ₀ + τ`, per crossing the
+//! ([`record`](super::exponential::record)): per piece `E_δ₀^m e^{Ãτ}` with `h = m δ₀ + τ`, per crossing the
 //! saltation matrix of a force jump, from `u̇_e` at the root.
 //!
 //! What it saves: the orbit's sub-steps (the drivetrain's ~9,000 per period at its contact
@@ -19,8 +19,8 @@
 //! the samples is not seen; its piece is shorter than the spacing `2π/(16Hω)` and grazes the
 //! kink by less than `⅛ δθ² max|u''|`.
 
-use super::exponential::ExpFlow;
-use super::record::Step;
+use super::exponential::exp_flow::ExpFlow;
+use super::exponential::record::Step;
 use crate::error::{Error, Result};
 use crate::harmonic::kinks::{bracketed_newton, derivatives};
 use crate::harmonic::{AftPlan, HarmonicBasis};

@@ -6,7 +6,7 @@
 //! vectors, `a_i += s_{i,d} q_{i+d} + c_{i,d} q̇_{i+d}`: contiguous loops the compiler turns
 //! into vector instructions. The few other entries (branches, meshes across the line) are
 //! kept in compressed rows. This product is nearly all the cost of the monodromy action of
-//! [`sparse_action`](super::sparse_action) (four per Runge–Kutta step); the band form made the
+//! [`sparse_action`](super::large::sparse_action) (four per Runge–Kutta step); the band form made the
 //! 1000-DOF chain's action three times faster than compressed rows alone.
 
 use crate::model::{Model, SparseMatrix};

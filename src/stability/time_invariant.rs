@@ -7,7 +7,7 @@
 //!
 //! so the monodromy matrix is `Φ(T) = e^{A T}` and the multipliers are `μ_j = e^{λ_j T}` for
 //! the eigenvalues `λ_j` of `A`, `T = 2π ν / Ω` the orbit's period. The eigenvalues do not
-//! depend on the speed: a sweep computes them once ([`FloquetCache`]) and each point costs
+//! depend on the speed: a sweep computes them once ([`FloquetCache`](crate::stability::FloquetCache)) and each point costs
 //! `2n` exponentials. The HB solution of such a model is the exact periodic orbit (loads at
 //! orders up to H, nothing couples the harmonics), so nothing is shot or polished.
 //!
@@ -17,7 +17,7 @@
 
 use super::neutral::rigid_body_modes;
 use super::system::Coordinates;
-use super::{Floquet, FloquetCache, Orbit};
+use super::{Floquet, Orbit};
 use crate::error::Result;
 use crate::model::Model;
 use crate::solution::Solution;
@@ -25,7 +25,7 @@ use nalgebra::DMatrix;
 use num_complex::Complex64;
 
 /// The eigenvalues of `A` that decide stability and the number of neutral multipliers left
-/// out, kept by a sweep ([`FloquetCache`]).
+/// out, kept by a sweep ([`FloquetCache`](crate::stability::FloquetCache)).
 #[derive(Debug, Clone)]
 pub(crate) struct StateEigenvalues {
     lambdas: Vec<Complex64>,
@@ -54,16 +54,16 @@ fn fingerprint(model: &Model) -> u64 {
 pub(crate) fn floquet(
     model: &Model,
     solution: &Solution,
-    cache: &mut FloquetCache,
+    kept: &mut Option<StateEigenvalues>,
 ) -> Result<Option<Floquet>> {
     if !model.is_linear_time_invariant() || model.n_dofs() > MAX_DOFS {
         return Ok(None);
     }
     let id = fingerprint(model);
-    if cache.time_invariant.as_ref().is_none_or(|e| e.model != id) {
-        cache.time_invariant = state_eigenvalues(model, id)?;
+    if kept.as_ref().is_none_or(|e| e.model != id) {
+        *kept = state_eigenvalues(model, id)?;
     }
-    let Some(eig) = &cache.time_invariant else {
+    let Some(eig) = &*kept else {
         return Ok(None);
     };
     let basis = solution.basis();
@@ -75,7 +75,7 @@ pub(crate) fn floquet(
         neutral: eig.neutral,
         orbit_correction: 0.0,
         polished: true,
-        orbit_start: super::shooting::hb_start(solution),
+        orbit_start: super::hb_state::hb_start(solution),
         steps: 0,
         reduction: None,
         orbit: Orbit::Exact,
@@ -151,9 +151,7 @@ mod tests {
             .unwrap();
         let hb = HarmonicBalance::new(&model, HarmonicBasis::new(w, 3).unwrap()).unwrap();
         let sol = Newton::new().solve(&hb, &mut hb.workspace()).unwrap();
-        let f = floquet(&model, &sol, &mut FloquetCache::default())
-            .unwrap()
-            .unwrap();
+        let f = floquet(&model, &sol, &mut None).unwrap().unwrap();
         let t = std::f64::consts::TAU / w;
         let decay = (-c / (2.0 * m) * t).exp();
         assert_eq!(f.multipliers.len(), 2);

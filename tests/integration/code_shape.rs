@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 const MAX_LINES: usize = 100;
 
 /// The `.rs` files under `dir`, recursively.
-fn rust_files(dir: &Path) -> Vec<PathBuf> {
+pub(super) fn rust_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -24,7 +24,7 @@ fn rust_files(dir: &Path) -> Vec<PathBuf> {
 /// `line` with string and char literals and a trailing `//` comment blanked out, so that the
 /// braces left are the code's (format strings' `{}` and `'{'` do not count). Raw strings
 /// spanning lines are not handled: src/cli has none.
-fn code_of(line: &str) -> String {
+pub(super) fn code_of(line: &str) -> String {
     let chars: Vec<char> = line.chars().collect();
     let (mut out, mut i) = (String::new(), 0);
     while i < chars.len() {

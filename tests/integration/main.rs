@@ -67,6 +67,7 @@ mod stability_at_scale;
 mod stability_exponential;
 mod stability_harmonic_orbit;
 mod stability_memory;
+mod stability_rooms;
 mod stability_time_domain;
 mod stability_worker;
 mod tail_correction;

@@ -263,7 +263,7 @@ fn crank_fundamental_run_up_keeps_multipliers_on_the_reported_orbits() {
 
 /// The same drivetrain with a cosine mesh stiffness: not affine between its kinks, so the
 /// exponential flow's pieces do not apply, and before the HB orbit's own multipliers came
-/// from Runge–Kutta along it (`stability/guide.rs`) the middle branch was labelled stable
+/// from Runge–Kutta along it (`stability/integrated/guide.rs`) the middle branch was labelled stable
 /// (shooting glided onto the outer orbits, up to 2.4 of the dynamic range away) with both
 /// turns spurious.
 #[test]

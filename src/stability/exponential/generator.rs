@@ -1,4 +1,4 @@
-//! The pieces' generators of the exponential flow ([`exponential`](super::exponential)) and
+//! The pieces' generators of the exponential flow ([`exponential`](super::exp_flow)) and
 //! what is kept per generator: the scaled load as an oscillator ([`Forcing`]), and per
 //! distinct generator ([`State`]) the Taylor powers and the exact sub-step `(E_δ₀, X_δ₀)`; the
 //! monodromy matrix's factors per generator are the [`propagator`](super::propagator)'s.
@@ -17,7 +17,7 @@
 
 use super::expm::{inverse_factorial, phi_narrow, squarings, ExpWork, Powers};
 use super::kernels::{gemv_sum, product};
-use super::system::Coordinates;
+use crate::stability::system::Coordinates;
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 
@@ -296,7 +296,7 @@ impl State {
     }
 
     /// The state of `core` for the monodromy matrix alone (an orbit that is not integrated,
-    /// [`Orbit::Harmonic`](super::Orbit::Harmonic)): without the load's part `X_δ₀`.
+    /// [`Orbit::Harmonic`](crate::stability::Orbit::Harmonic)): without the load's part `X_δ₀`.
     pub(crate) fn without_load(core: Arc<Core>, offset: DVector<f64>) -> Self {
         Self {
             core,

@@ -199,7 +199,7 @@ mod tests {
 
     thread_local! {
         /// Forces the assembler onto a second thread (`Some(true)`) or not.
-        pub(super) static FORCE: Cell<Option<bool>> = const { Cell::new(None) };
+        pub(crate) static FORCE: Cell<Option<bool>> = const { Cell::new(None) };
     }
 
     /// A backlash chain with contact damping (force jumps, saltation matrices) whose shooting

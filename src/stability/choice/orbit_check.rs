@@ -14,13 +14,16 @@
 //! is the reduction's estimate, which for the HB orbit's multipliers compares them with the
 //! exact orbit's on the wider basis (both errors together).
 
-use super::dispatch::FloquetCache;
+use super::cache::FloquetCache;
 use super::orbit_identity::{forget_orbit, same_kind};
-use super::shooting::{distance, shoot, Goal, Start};
-use super::system::Coordinates;
-use super::{Floquet, FloquetOptions, Integrator, Orbit, ORBIT_CHECK_EVERY, STABILITY_MARGIN};
 use crate::error::Result;
 use crate::solution::Solution;
+use crate::stability::distance;
+use crate::stability::shooting::shoot::{shoot, Goal, Start};
+use crate::stability::system::Coordinates;
+use crate::stability::{
+    Floquet, FloquetOptions, Integrator, Orbit, ORBIT_CHECK_EVERY, STABILITY_MARGIN,
+};
 use num_complex::Complex64;
 
 /// How far the leading multipliers may move ([`distance`]) from those of the last measurement
@@ -35,7 +38,7 @@ impl FloquetOptions {
     /// measurement, and where one lies within ten times its measured difference of the unit
     /// circle (the exact orbit's multipliers are then the answer). Laws that are not piecewise
     /// affine: the exact orbit.
-    pub(super) fn harmonic_orbit(
+    pub(crate) fn harmonic_orbit(
         &self,
         sys: &Coordinates,
         solution: &Solution,
@@ -118,19 +121,19 @@ impl FloquetOptions {
 /// The HB orbit's multipliers against the exact orbit's at the last point where both were
 /// computed, and the analyses since.
 #[derive(Debug, Clone)]
-pub(super) struct OrbitCheck {
+pub(crate) struct OrbitCheck {
     /// What is reported: the larger of the last two measurements of their [`distance`].
-    pub(super) distance: f64,
+    pub(crate) distance: f64,
     /// The last measurement alone.
-    pub(super) measured: f64,
+    pub(crate) measured: f64,
     /// The leading HB-orbit multipliers (at most 8) and each one's distance to the nearest
     /// exact one.
     leading: Vec<(Complex64, f64)>,
-    pub(super) since: usize,
+    pub(crate) since: usize,
 }
 
 impl OrbitCheck {
-    pub(super) fn new(harmonic: &[Complex64], exact: &[Complex64], distance: f64) -> Self {
+    pub(crate) fn new(harmonic: &[Complex64], exact: &[Complex64], distance: f64) -> Self {
         let leading = harmonic
             .iter()
             .take(8)
@@ -159,7 +162,7 @@ impl OrbitCheck {
     /// difference of its nearest checked multiplier (plus [`STABILITY_MARGIN`]) of the unit
     /// circle: the stability decision, or a bifurcation's place, is then the exact orbit's to
     /// make.
-    pub(super) fn too_close(&self, multipliers: &[Complex64]) -> bool {
+    pub(crate) fn too_close(&self, multipliers: &[Complex64]) -> bool {
         multipliers.iter().take(8).any(|m| {
             let d = self
                 .leading

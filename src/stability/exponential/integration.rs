@@ -3,11 +3,11 @@
 //! ([`record`](super::record)), or Runge–Kutta, which integrates the variational equation with
 //! the state (its monodromy matrix comes with every pass).
 
-use super::dopri::Stepper;
-use super::exponential::ExpFlow;
-use super::flow::{Flow, FlowOptions};
+use super::exp_flow::ExpFlow;
 use super::record::Step;
 use crate::error::{Error, Result};
+use crate::stability::integrated::dopri::Stepper;
+use crate::stability::integrated::flow::{Flow, FlowOptions};
 use nalgebra::DMatrix;
 
 /// The flow over a period: exponentials or Runge–Kutta.

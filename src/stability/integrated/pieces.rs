@@ -1,12 +1,12 @@
 //! Where each element is relative to its kinks, shared by both flows ([`flow`](super::flow),
-//! [`exponential`](super::exponential)): the law evaluated on the current side of each kink
+//! [`exponential`](crate::stability::exponential::exp_flow)): the law evaluated on the current side of each kink
 //! (continued linearly from the one-sided limit where a state strays across), the side from a
 //! state, and the first crossing of a kink inside a step from the cubic Hermite interpolant of
 //! `u` (values and rates at both ends); the saltation matrix of a force jump at a crossing.
 
 use super::cubic::Cubic;
 use super::dopri::hermite;
-use super::system::Coordinates;
+use crate::stability::system::Coordinates;
 
 /// `side[e] = j` means `kinks[e][j-1] <= u < kinks[e][j]` (open at the ends).
 pub(crate) struct Pieces {

@@ -18,12 +18,12 @@
 //! The cost is `2(2n + s)` period integrations for the multipliers plus `2n + s + 1` per
 //! Newton step: small models only ([`MAX_DOFS`]), and grounded ones ([`available`]).
 
-use super::neutral::rigid_body_modes;
-use super::system::Coordinates;
-use super::{orbit_distance, Floquet, FloquetOptions, Orbit};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solution::Solution;
+use crate::stability::neutral::rigid_body_modes;
+use crate::stability::system::Coordinates;
+use crate::stability::{orbit_distance, Floquet, FloquetOptions, Orbit};
 use crate::timesim::PeriodMap;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -77,7 +77,7 @@ pub(crate) fn floquet(
         map,
         used: std::cell::Cell::new(0),
     };
-    let hb = super::shooting::hb_start(solution);
+    let hb = crate::stability::hb_state::hb_start(solution);
     let mut x = hb.clone();
     x.extend(march(model, solution, map.map.laws()));
     let scales = scales(model, solution, map.map.laws());
@@ -179,7 +179,7 @@ impl Budgeted<'_> {
 /// element at its largest tangent `|∂f/∂u|`, `|∂f/∂u̇|` on the HB orbit), so one period takes
 /// at least `λ νT / 5` steps, and the multipliers alone `2(2n + s) + 1` periods.
 fn check_cost(model: &Model, solution: &Solution) -> Result<()> {
-    let Some(rate) = super::linear_rate::fastest_rate(model, solution) else {
+    let Some(rate) = crate::stability::linear_rate::fastest_rate(model, solution) else {
         return Ok(());
     };
     let states: usize = model

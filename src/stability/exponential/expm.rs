@@ -1,5 +1,5 @@
 //! Matrix functions of the small dense generators of the exponential flow
-//! ([`exponential`](super::exponential)).
+//! ([`exponential`](super::exp_flow)).
 //!
 //! **Exponential.** For `‖Z‖₁ <= 1` the Taylor polynomial of degree 16,
 //! `T(Z) = Σ_{i<=16} Zⁱ/i!`, differs from `e^Z` by at most `Σ_{i>16} 1/i! < 3e-15` (degree 12

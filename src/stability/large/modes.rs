@@ -93,7 +93,7 @@ fn subspace_iteration(
     };
     let mut x = random(n, p);
     for _ in 0..200 {
-        let mut y = super::system::sparse_times(m, &x);
+        let mut y = crate::stability::system::sparse_times(m, &x);
         factor.solve_in_place(&mut y);
         // Columns scaled by 1/(λ + σ) span a wide range (a free or softly grounded model):
         // M-orthonormalise them in order before the Ritz step.
@@ -179,8 +179,8 @@ fn rayleigh_ritz(
     m: &SparseMatrix,
     y: &DMatrix<f64>,
 ) -> Result<(Vec<f64>, DMatrix<f64>)> {
-    let ky = y.transpose() * super::system::sparse_times(k0, y);
-    let my = y.transpose() * super::system::sparse_times(m, y);
+    let ky = y.transpose() * crate::stability::system::sparse_times(k0, y);
+    let my = y.transpose() * crate::stability::system::sparse_times(m, y);
     let my = (&my + my.transpose()) * 0.5;
     let p = y.ncols();
     let chol = my.cholesky().ok_or_else(|| Error::Solver {

@@ -26,8 +26,8 @@
 use super::dopri::{step_factor, Stepper};
 use super::guide::Guide;
 use super::pieces::Pieces;
-use super::system::Coordinates;
 use crate::error::{Error, Result};
+use crate::stability::system::Coordinates;
 use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
 
 /// The integration options and counters.

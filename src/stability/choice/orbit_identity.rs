@@ -7,7 +7,7 @@
 //! step with the previous point's monodromy matrix) glides onto a stable orbit of the same
 //! speed, whose multipliers then label the unstable branch stable. The orbit found is told
 //! apart from the one reported by how far its start lies from the HB state at `t = 0`, in the
-//! HB orbit's own dynamic terms ([`orbit_distance`]): the HB solution's error there is a small
+//! HB orbit's own dynamic terms ([`orbit_distance`](crate::stability::orbit_distance)): the HB solution's error there is a small
 //! fraction of its vibration, the distance to another orbit of the same speed a large one.
 //!
 //! Measured on the single-stage drivetrain of `tests/integration/s_curve.rs`-like run-ups
@@ -16,80 +16,19 @@
 //! peak to peak polished to the upper branch's 26.9 µm, or 48.9 µm to the lower branch's
 //! 5.3 µm); [`OTHER_ORBIT_DISTANCE`] lies between.
 
-use super::dispatch::FloquetCache;
-use super::shooting::{shoot, Goal, Start};
-use super::system::Coordinates;
-use super::{Floquet, FloquetOptions, Orbit};
+use super::cache::FloquetCache;
 use crate::error::Result;
-use crate::model::Model;
 use crate::solution::Solution;
-
-/// A shooting whose orbit starts farther than this ([`orbit_distance`]) from the HB state has
-/// found another periodic orbit than the HB solution's.
-pub const OTHER_ORBIT_DISTANCE: f64 = 5e-3;
-
-/// How far the state `x = (q, q̇)` (the model's DOFs) lies from the HB orbit's state at `t = 0`
-/// (`hb`), in positions: the largest of
-///
-/// * `|q_i − q_i*| / A`, `A = max_i Σ_{k≥1} |Q_ik|` the largest dynamic amplitude of a DOF
-///   (static wind-up and the rigid-body position do not count), and
-/// * for every element that is not linear in the state (contacts, stops, nonlinear springs),
-///   `|w·(q − q*)| / A_e`, `A_e = Σ_{k≥1} |w·Q_k|` its own dynamic amplitude (at least 1e-3 of
-///   `Σ|w_i| A`: an element that hardly moves is judged by the DOFs' range).
-///
-/// Velocities are left out: the HB velocity converges slowest where a stiffness jumps.
-pub fn orbit_distance(model: &Model, solution: &Solution, hb: &[f64], x: &[f64]) -> f64 {
-    let n = model.n_dofs();
-    if !x.iter().chain(hb).all(|v| v.is_finite()) {
-        return f64::INFINITY;
-    }
-    let h = solution.basis().harmonics();
-    let dynamic = |i: usize| (1..=h).map(|k| solution.harmonic(i, k).norm()).sum::<f64>();
-    let largest = (0..n).map(dynamic).fold(0.0, f64::max);
-    let statics = (0..n)
-        .map(|i| solution.harmonic(i, 0).norm())
-        .fold(0.0, f64::max);
-    // A solution at rest: judged against its static size (or absolutely).
-    let a = if largest > 0.0 {
-        largest
-    } else if statics > 0.0 {
-        1e-6 * statics
-    } else {
-        1.0
-    };
-    let dofs = (0..n).map(|i| (x[i] - hb[i]).abs() / a).fold(0.0, f64::max);
-    let elements = model
-        .elements()
-        .iter()
-        .filter(|e| !(e.law().is_linear_in_state() || e.law().is_linear_time_invariant()))
-        .map(|e| {
-            let w = e.weights();
-            let own: f64 = (1..=h)
-                .map(|k| {
-                    w.iter()
-                        .map(|&(i, c)| solution.harmonic(i, k) * c)
-                        .sum::<num_complex::Complex64>()
-                        .norm()
-                })
-                .sum();
-            let floor = 1e-3 * a * w.iter().map(|&(_, c)| c.abs()).sum::<f64>();
-            let du: f64 = w.iter().map(|&(i, c)| c * (x[i] - hb[i])).sum();
-            du.abs() / own.max(floor).max(f64::MIN_POSITIVE)
-        })
-        .fold(0.0, f64::max);
-    let d = dofs.max(elements);
-    if d.is_finite() {
-        d
-    } else {
-        f64::INFINITY
-    }
-}
+use crate::stability::shooting::shoot::{shoot, Goal, Start};
+use crate::stability::system::Coordinates;
+use crate::stability::OTHER_ORBIT_DISTANCE;
+use crate::stability::{Floquet, FloquetOptions, Orbit};
 
 /// How many times its truncation estimate the HB solution may lie from the exact orbit it
 /// stands for ([`other_orbit_threshold`]).
 const TRUNCATION_FACTOR: f64 = 4.0;
 
-/// The [`orbit_distance`] beyond which a shooting's orbit is taken for another orbit than the
+/// The [`orbit_distance`](crate::stability::orbit_distance) beyond which a shooting's orbit is taken for another orbit than the
 /// HB solution's: [`OTHER_ORBIT_DISTANCE`], or [`TRUNCATION_FACTOR`] times the solution's
 /// [truncation estimate](Solution::truncation_estimate) where that is larger. An HB solution
 /// whose top harmonics are not small may lie that far from its own exact orbit, and the
@@ -97,7 +36,7 @@ const TRUNCATION_FACTOR: f64 = 4.0;
 /// estimate 1) lies 8e-3 to 3e-2 from the exact middle-branch orbits, whose multipliers
 /// (unstable) are right where the HB orbit's own (stable) are not. The S-shaped run-ups at
 /// H = 128 have estimates of 2e-5 to 2e-3 and other orbits from 8e-3 on.
-pub(super) fn other_orbit_threshold(solution: &Solution) -> f64 {
+pub(crate) fn other_orbit_threshold(solution: &Solution) -> f64 {
     let t = solution.truncation_estimate();
     if t.is_finite() {
         OTHER_ORBIT_DISTANCE.max(TRUNCATION_FACTOR * t)
@@ -113,7 +52,7 @@ impl FloquetOptions {
     /// kind (the same stability and number of real multipliers above +1): the HB solution is
     /// merely inaccurate (an under-resolved orbit, the two-shaft model at 60 rpm), `found`
     /// stands without the mark. Another kind: the HB orbit's own, marked.
-    pub(super) fn own_multipliers(
+    pub(crate) fn own_multipliers(
         &self,
         sys: &Coordinates,
         solution: &Solution,
@@ -136,10 +75,10 @@ impl FloquetOptions {
     }
 
     /// The multipliers of the HB orbit itself, for every law: the exponential flow's pieces
-    /// where every law is affine between its kinks ([`harmonic_orbit`](super::harmonic_orbit)),
+    /// where every law is affine between its kinks ([`harmonic_orbit`](crate::stability::harmonic_orbit)),
     /// the Runge–Kutta flow of the variational equation along it otherwise
-    /// ([`guide`](super::guide)).
-    pub(super) fn hb_orbit(
+    /// ([`guide`](crate::stability::integrated::guide)).
+    pub(crate) fn hb_orbit(
         &self,
         sys: &Coordinates,
         solution: &Solution,
@@ -164,7 +103,7 @@ impl FloquetOptions {
 
 /// Another orbit's monodromy matrix and corrections would lead the next points' shootings to
 /// it as well: dropped.
-pub(super) fn forget_orbit(cache: &mut FloquetCache) {
+pub(crate) fn forget_orbit(cache: &mut FloquetCache) {
     cache.jacobian = None;
     cache.corrections.clear();
 }
@@ -173,7 +112,7 @@ pub(super) fn forget_orbit(cache: &mut FloquetCache) {
 /// unstable, leading moduli within a factor 2 of each other (on the frozen-stage car's middle
 /// branch with a cosine mesh stiffness a shooting found an orbit with 4.1 where the HB orbit's
 /// own leading multiplier is 1.1e11: another saddle).
-pub(super) fn same_kind(a: &Floquet, b: &Floquet) -> bool {
+pub(crate) fn same_kind(a: &Floquet, b: &Floquet) -> bool {
     let unstable = !a.is_stable() && !b.is_stable();
     a.is_stable() == b.is_stable()
         && a.real_unstable() == b.real_unstable()

@@ -4,16 +4,19 @@
 //! the multipliers of the final orbit's `Φ` without its neutral block.
 
 use super::chord::{iterate, KeptJacobian, Outcome, Problem};
-use super::exponential::ExpFlow;
-use super::flow::{Flow, FlowOptions};
-use super::guide::Guide;
-use super::integration::Integration;
-use super::kept::KeptGenerators;
-use super::scales::scales;
-use super::system::Coordinates;
-use super::{affine, eigenvalues, neutral, Floquet, FloquetOptions, Integrator, Orbit};
 use crate::error::{Error, Result};
 use crate::solution::Solution;
+use crate::stability::exponential::affine;
+use crate::stability::exponential::exp_flow::ExpFlow;
+use crate::stability::exponential::integration::Integration;
+use crate::stability::exponential::kept::KeptGenerators;
+use crate::stability::hb_state::hb_start;
+use crate::stability::integrated::flow::{Flow, FlowOptions};
+use crate::stability::integrated::guide::Guide;
+use crate::stability::neutral;
+use crate::stability::scales::scales;
+use crate::stability::system::Coordinates;
+use crate::stability::{eigenvalues, Floquet, FloquetOptions, Integrator, Orbit};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -48,7 +51,7 @@ pub(crate) enum Goal<'a> {
 }
 
 /// A Floquet analysis and the sensitivity of its multipliers to the orbit's start: `κ` =
-/// the [`distance`] between the multipliers of the first two shooting iterations over the
+/// the [`distance`](crate::stability::distance) between the multipliers of the first two shooting iterations over the
 /// first Newton step (`None` if the first period was already converged).
 pub(crate) struct Shot {
     pub(crate) floquet: Floquet,
@@ -235,7 +238,7 @@ pub(crate) fn shoot(
     let orbit_distance = if harmonic {
         0.0
     } else {
-        super::orbit_distance(sys.model, solution, &hb_here, &orbit_start)
+        crate::stability::orbit_distance(sys.model, solution, &hb_here, &orbit_start)
     };
     let orbit_correction = (0..2 * n_model)
         .map(|i| (orbit_start[i] - hb_here[i]).abs() / full_scale(i))
@@ -271,39 +274,4 @@ pub(crate) fn shoot(
         ahead,
         jacobian: KeptJacobian::new(phi, sys, (scale_q, scale_v)),
     })
-}
-
-/// The HB state `(q(0), q̇(0))` in the model's DOFs: `q_i(0) = Σ_k Re Q_ik`,
-/// `q̇_i(0) = -Σ_k k ω Im Q_ik` (`ω` the fundamental), the same sums as
-/// [`Solution::displacement`] and [`Solution::velocity`] at `θ = 0` without their rotations.
-pub(crate) fn hb_start(solution: &Solution) -> Vec<f64> {
-    let n = solution.dof_names().len();
-    let h = solution.basis().harmonics();
-    let w = solution.basis().fundamental();
-    let q = (0..n).map(|i| (0..=h).map(|k| solution.harmonic(i, k).re).sum::<f64>());
-    let v = (0..n).map(|i| {
-        (1..=h)
-            .map(|k| -(solution.harmonic(i, k).im * (k as f64 * w)))
-            .sum::<f64>()
-    });
-    q.chain(v).collect()
-}
-
-/// The larger of `max_i min_j |a_i - b_j|` over the leading `a_i` and the same over the
-/// leading `b_j`, leading meaning a modulus at least half the largest of both sets (at most 8
-/// from each): a multiplier that only one basis has counts with its distance to the other's
-/// nearest.
-pub(crate) fn distance(a: &[Complex64], b: &[Complex64]) -> f64 {
-    let top = a
-        .first()
-        .map_or(0.0, |m| m.norm())
-        .max(b.first().map_or(0.0, |m| m.norm()));
-    let one_way = |a: &[Complex64], b: &[Complex64]| {
-        a.iter()
-            .take(8)
-            .filter(|m| m.norm() >= 0.5 * top)
-            .map(|m| b.iter().map(|o| (m - o).norm()).fold(m.norm(), f64::min))
-            .fold(0.0, f64::max)
-    };
-    one_way(a, b).max(one_way(b, a))
 }

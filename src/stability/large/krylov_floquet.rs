@@ -1,7 +1,7 @@
 //! The leading Floquet multipliers of an HB orbit without the `2n × 2n` monodromy matrix:
 //! the Arnoldi iteration ([`arnoldi`](super::arnoldi)) on the monodromy action of
 //! [`sparse_action`](super::sparse_action), for models with many modes in the excitation band
-//! ([`FloquetMethod::Arnoldi`](super::FloquetMethod::Arnoldi)).
+//! ([`FloquetMethod::Arnoldi`](crate::stability::FloquetMethod::Arnoldi)).
 //!
 //! What the answer is worth has two parts, both reported (`Reduction::estimate`, relative to
 //! the largest modulus): the Krylov part, the change of the leading Ritz values between the
@@ -13,11 +13,11 @@
 //! multiplier that decides stability. The steps are refined until it is below
 //! [`INTEGRATION_TOL`].
 
-use super::linear_rate::{absolute_row_sums, inverse_diagonal_mass};
 use super::sparse_action::VariationalAction;
 use crate::error::Result;
 use crate::model::Model;
 use crate::solution::Solution;
+use crate::stability::linear_rate::{absolute_row_sums, inverse_diagonal_mass};
 use num_complex::Complex64;
 
 /// Most Krylov vectors (monodromy actions) per analysis.
@@ -38,7 +38,10 @@ const MAX_SUBDIVISION: usize = 16;
 /// apply (a law with memory, a mass matrix that is not diagonal, a force that jumps at a
 /// kink the orbit crosses, a free-free model, whose neutral multipliers 1 the iteration would
 /// not set apart).
-pub(crate) fn floquet(model: &Model, solution: &Solution) -> Result<Option<super::Floquet>> {
+pub(crate) fn floquet(
+    model: &Model,
+    solution: &Solution,
+) -> Result<Option<crate::stability::Floquet>> {
     let Some(action) = VariationalAction::new(model, solution, 1)? else {
         return Ok(None);
     };
@@ -93,14 +96,14 @@ pub(crate) fn floquet(model: &Model, solution: &Solution) -> Result<Option<super
         .filter(|v| v.norm() >= 1e-3 * top)
         .take(2 * super::arnoldi::LEADING)
         .collect();
-    Ok(Some(super::Floquet {
+    Ok(Some(crate::stability::Floquet {
         multipliers,
         neutral: 0,
         orbit_correction: 0.0,
         polished: false,
-        orbit_start: super::shooting::hb_start(solution),
+        orbit_start: crate::stability::hb_state::hb_start(solution),
         steps,
-        reduction: Some(super::Reduction {
+        reduction: Some(crate::stability::Reduction {
             dofs: model.n_dofs(),
             modes: 0,
             attachment: 0,
@@ -109,7 +112,7 @@ pub(crate) fn floquet(model: &Model, solution: &Solution) -> Result<Option<super
             comparison_dofs: None,
             krylov: Some(ritz.vectors),
         }),
-        orbit: super::Orbit::Harmonic,
+        orbit: crate::stability::Orbit::Harmonic,
         orbit_difference: None,
         orbit_distance: 0.0,
         other_orbit: None,
@@ -173,7 +176,7 @@ fn integration_error(
     Ok(Some(squared.sqrt()))
 }
 
-/// Smallest model whose multipliers [`FloquetMethod::Auto`](super::FloquetMethod::Auto) takes
+/// Smallest model whose multipliers [`FloquetMethod::Auto`](crate::stability::FloquetMethod::Auto) takes
 /// from the Arnoldi iteration when every mode lies below the reduction's cut-off (a reduced
 /// basis would keep them all: a dense `2n × 2n` monodromy matrix).
 pub const ARNOLDI_FROM: usize = 256;

@@ -1,6 +1,6 @@
 //! The monodromy action `x ↦ Φ(T) x` of the HB orbit's variational equation in the model's own
 //! sparse matrices, for the Arnoldi iteration of models with many modes in the excitation band
-//! ([`FloquetMethod::Arnoldi`](super::FloquetMethod::Arnoldi)).
+//! ([`FloquetMethod::Arnoldi`](crate::stability::FloquetMethod::Arnoldi)).
 //!
 //! Along the HB orbit `q*(t)` the variational equation is
 //!
@@ -13,15 +13,15 @@
 //! bound, the contact stiffness included) keeps its amplitude to 0.1 % over a period and the
 //! slow ones that usually decide stability far better (`step_bound`). `Δk_e`, `Δd_e` are evaluated at every stage time from the HB orbit's harmonics.
 //! One action costs `8·steps` sparse products: no `2n × 2n` matrix is formed. A coefficient
-//! that jumps inside a step (a contact closing or opening) costs that step first order; [`leading`] measures the result against the dense monodromy on small models.
+//! that jumps inside a step (a contact closing or opening) costs that step first order; [`krylov_floquet`](super::krylov_floquet)'s tests measure the result against the dense monodromy on small models.
 //!
 //! The state is scaled, `x = (δq, δq̇/ω_ref)`, so the Krylov vectors weigh displacements and
 //! velocities alike (the eigenvalues are those of `Φ`).
 
-use super::linear_rate::{gershgorin, inverse_diagonal_mass, LinearRate};
 use crate::error::Result;
 use crate::model::Model;
 use crate::solution::Solution;
+use crate::stability::linear_rate::{gershgorin, inverse_diagonal_mass, LinearRate};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 

@@ -1,4 +1,4 @@
-//! The generators of the exponential flow ([`exponential`](super::exponential)) kept from one
+//! The generators of the exponential flow ([`exponential`](super::exp_flow)) kept from one
 //! point of a sweep to the next.
 //!
 //! A generator `Ã` of a piece depends on the basis, the state scales' ratio `ω_s` and the laws'

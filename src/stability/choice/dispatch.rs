@@ -1,85 +1,19 @@
 //! Which monodromy matrix: the dense one in the model's DOFs (`2n × 2n`, `O(n³)` per
-//! integration step) or the one on a reduced basis ([`reduction`](super::reduction): the
+//! integration step) or the one on a reduced basis ([`reduction`](crate::stability::large::reduction): the
 //! modes below a cut-off plus attachment modes, `2(r + a) × 2(r + a)` whatever n), and the
 //! reduction's accuracy estimate.
 
-use super::chord::KeptJacobian;
-use super::kept::KeptGenerators;
-use super::orbit_check::OrbitCheck;
+use super::cache::{FloquetCache, PREDICTION_POINTS};
 use super::orbit_identity::other_orbit_threshold;
-use super::reduction::{reduced_basis, ModeCache};
-use super::shooting::{distance, hb_start, shoot, Goal, Shot, Start};
-use super::system::Coordinates;
-use super::{Floquet, FloquetOptions, Orbit};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solution::Solution;
-
-/// How [`FloquetOptions::compute`] forms the monodromy matrix.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FloquetMethod {
-    /// Dense below [`FloquetMethod::REDUCED_FROM`] DOFs, reduced from there on.
-    #[default]
-    Auto,
-    /// Dense in the model's DOFs (up to [`Model::MAX_DENSE_DOFS`]).
-    Dense,
-    /// On the reduced basis (modes below the cut-off and attachment modes).
-    Reduced,
-    /// The leading multipliers of the HB orbit (largest moduli) by the Arnoldi iteration on
-    /// the monodromy action, integrated in the model's own sparse matrices: no `2n × 2n`
-    /// matrix, for models with many modes in the excitation band (`krylov_floquet` module).
-    /// Diagonal mass matrices, no laws with memory, no free-free models.
-    Arnoldi,
-}
-
-impl FloquetMethod {
-    /// The smallest model that [`FloquetMethod::Auto`] reduces.
-    pub const REDUCED_FROM: usize = 64;
-
-    /// The method `self` means for `model` (`Auto` resolved).
-    pub fn resolve(self, model: &Model) -> FloquetMethod {
-        match self {
-            FloquetMethod::Auto if model.n_dofs() >= Self::REDUCED_FROM => FloquetMethod::Reduced,
-            FloquetMethod::Auto => FloquetMethod::Dense,
-            m => m,
-        }
-    }
-}
-
-/// The reduced basis of a Floquet analysis and how far its multipliers can be trusted.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Reduction {
-    /// Size of the basis, `r + a` (the monodromy matrix is twice that square).
-    pub dofs: usize,
-    /// r, undamped modes kept (every mode below the cut-off).
-    pub modes: usize,
-    /// a, attachment modes (static responses to unit forces on the element coordinates, less
-    /// those already in the span).
-    pub attachment: usize,
-    /// The cut-off ω_c in rad/s.
-    pub cutoff: f64,
-    /// The accuracy estimate: the largest distance `min_j |μ_i - μ'_j|` of the leading
-    /// multipliers `μ_i` (modulus at least half the largest, at most 8) to those `μ'_j` on the
-    /// basis with twice the cut-off (more if that adds no mode). `Some(0)` when the basis
-    /// spans the whole space (a similarity transform: only the integrator's error is left);
-    /// `None` when not estimated ([`FloquetOptions::estimate`]). For the HB orbit's
-    /// multipliers ([`Orbit::Harmonic`]) the distance to the exact orbit's on the wider
-    /// basis: the orbit's error and the basis's together.
-    #[serde(default)]
-    pub estimate: Option<f64>,
-    /// Size of the comparison basis of the estimate.
-    #[serde(default)]
-    pub comparison_dofs: Option<usize>,
-    /// With [`FloquetMethod::Arnoldi`]: the Krylov vectors (monodromy actions) the leading
-    /// multipliers took; `estimate` is then, relative to the largest modulus, the larger of
-    /// the last change of the leading Ritz values (the Krylov part) and the integration part,
-    /// `‖(Φ_{h/2} − Φ_h) y‖` for the leading Ritz vector `y` (the Runge–Kutta steps are
-    /// refined until it is below 1e-6); the basis is the model's own DOFs (`dofs`), nothing
-    /// cut.
-    #[serde(default)]
-    pub krylov: Option<usize>,
-}
+use crate::stability::exponential::kept::KeptGenerators;
+use crate::stability::hb_state::hb_start;
+use crate::stability::large::reduction::reduced_basis;
+use crate::stability::shooting::shoot::{shoot, Goal, Shot, Start};
+use crate::stability::system::Coordinates;
+use crate::stability::{distance, Floquet, FloquetMethod, FloquetOptions, Orbit, Reduction};
 
 /// Largest relative distance of the exact orbit's start from the HB state for which a shooting
 /// from a start predicted by earlier points is kept. Farther, it may have found another
@@ -96,17 +30,6 @@ const PREDICTED_ORBIT_DISTANCE: f64 = 1e-2;
 const PREDICTED_START: bool = true;
 
 impl FloquetOptions {
-    /// Defaults.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// These options with `method`.
-    pub fn with_method(mut self, method: FloquetMethod) -> Self {
-        self.method = method;
-        self
-    }
-
     /// The multipliers of the periodic orbit of `model` next to `solution`.
     pub fn compute(&self, model: &Model, solution: &Solution) -> Result<Floquet> {
         self.compute_with(model, solution, &mut FloquetCache::default())
@@ -140,7 +63,7 @@ impl FloquetOptions {
         // The variational equation of a law with memory is not the one of `(∂f/∂u, ∂f/∂u̇)`:
         // shooting on the time-domain model with the laws' states instead.
         if model.memory_element().is_some() {
-            return super::memory_shooting::floquet(model, solution, self);
+            return crate::stability::shooting::memory_shooting::floquet(model, solution, self);
         }
         let n = model.n_dofs();
         if solution.harmonics().len() < n || solution.dof_names().len() != n {
@@ -150,7 +73,9 @@ impl FloquetOptions {
                 got: format!("{} DOFs", solution.dof_names().len()),
             });
         }
-        if let Some(f) = super::time_invariant::floquet(model, solution, cache)? {
+        if let Some(f) =
+            crate::stability::time_invariant::floquet(model, solution, &mut cache.time_invariant)?
+        {
             return Ok(f);
         }
         // Every mode in the band a reduced basis keeps (a long chain at speed): the leading
@@ -158,15 +83,15 @@ impl FloquetOptions {
         let band =
             self.cutoff * solution.basis().harmonics() as f64 * solution.basis().fundamental();
         if self.method == FloquetMethod::Auto
-            && model.n_dofs() >= super::krylov_floquet::ARNOLDI_FROM
-            && super::krylov_floquet::every_mode_below(model, band)
+            && model.n_dofs() >= crate::stability::large::krylov_floquet::ARNOLDI_FROM
+            && crate::stability::large::krylov_floquet::every_mode_below(model, band)
         {
-            if let Some(f) = super::krylov_floquet::floquet(model, solution)? {
+            if let Some(f) = crate::stability::large::krylov_floquet::floquet(model, solution)? {
                 return Ok(f);
             }
         }
         if self.method == FloquetMethod::Arnoldi {
-            return super::krylov_floquet::floquet(model, solution)?.ok_or_else(|| {
+            return crate::stability::large::krylov_floquet::floquet(model, solution)?.ok_or_else(|| {
                 Error::invalid(
                     "floquet",
                     "method",
@@ -209,7 +134,7 @@ impl FloquetOptions {
     /// The multipliers of the exact orbit next to `solution` in the coordinates `sys`, by
     /// shooting: from the previous points' corrections (extrapolated along the last three) if
     /// that converges near, from the HB state otherwise.
-    pub(super) fn exact_orbit(
+    pub(crate) fn exact_orbit(
         &self,
         sys: &Coordinates,
         solution: &Solution,
@@ -370,84 +295,5 @@ impl FloquetOptions {
         info.estimate = Some(distance(&floquet.multipliers, &reference.multipliers));
         floquet.steps += reference.steps;
         Ok(())
-    }
-}
-
-/// What a sweep's Floquet analyses keep from one point to the next
-/// ([`FloquetOptions::compute_with`]): the undamped modes of the model, the last three orbit
-/// corrections (the shooting of the next point starts from the HB state plus their
-/// extrapolation in Ω), the last monodromy matrix (the first Jacobian of the next shooting's
-/// chord steps) and the sensitivity of the multipliers to the orbit measured by the last
-/// shooting that measured it.
-#[derive(Debug, Clone, Default)]
-pub struct FloquetCache {
-    pub(super) modes: ModeCache,
-    /// The exponential flow's generators of the last point.
-    pub(super) generators: KeptGenerators,
-    /// The last orbit corrections `(Ω, (δq, δq̇))`, oldest first.
-    pub(super) corrections: Vec<(f64, Vec<f64>)>,
-    pub(super) jacobian: Option<KeptJacobian>,
-    pub(super) kappa: Option<f64>,
-    /// How long the last point's analysis took (set by the sweep that owns the cache).
-    last_time: Option<std::time::Duration>,
-    /// The last measurement of the HB orbit's multipliers against the exact orbit's.
-    pub(super) orbit_check: Option<OrbitCheck>,
-    /// The HB orbit's pieces did not apply (laws that are not piecewise affine): the next
-    /// points go to the exact orbit directly.
-    pub(super) exact_only: bool,
-    /// The state matrix's eigenvalues of a linear time-invariant model.
-    pub(super) time_invariant: Option<super::time_invariant::StateEigenvalues>,
-}
-
-/// Orbit corrections kept for the next point's prediction (a quadratic in Ω).
-const PREDICTION_POINTS: usize = 3;
-
-impl FloquetCache {
-    /// How long the last point's analysis took, if a sweep recorded it.
-    pub(crate) fn last_time(&self) -> Option<std::time::Duration> {
-        self.last_time
-    }
-
-    /// Records how long the last point's analysis took.
-    pub(crate) fn set_last_time(&mut self, time: std::time::Duration) {
-        self.last_time = Some(time);
-    }
-
-    /// The orbit correction `(δq, δq̇)` (`len` values) predicted at `omega` from the last
-    /// ones if the last is within 20 %: their Lagrange polynomial through `(Ω_i, d_i)` (at most
-    /// quadratic), over the last points on which the sweep goes on in the same direction by
-    /// at most twice its last step (not across a turn of the branch), the last `d` alone
-    /// otherwise.
-    fn predicted_correction(&self, omega: f64, len: usize) -> Option<Vec<f64>> {
-        let (w_last, d_last) = self.corrections.last()?;
-        if (omega - w_last).abs() > 0.2 * w_last || d_last.len() != len {
-            return None;
-        }
-        // The longest run of usable points ending at the last one.
-        let mut used = 1;
-        for k in (0..self.corrections.len() - 1).rev() {
-            let (w0, d0) = &self.corrections[k];
-            let w1 = self.corrections[k + 1].0;
-            let ratio = (omega - w_last) / (w1 - w0);
-            let same_way = (w1 - w0) * (omega - w_last) > 0.0;
-            if !(same_way && ratio <= 2.0 && d0.len() == len) {
-                break;
-            }
-            used += 1;
-        }
-        let points = &self.corrections[self.corrections.len() - used..];
-        let mut out = vec![0.0; len];
-        for (i, (wi, di)) in points.iter().enumerate() {
-            let weight: f64 = points
-                .iter()
-                .enumerate()
-                .filter(|&(j, _)| j != i)
-                .map(|(_, (wj, _))| (omega - wj) / (wi - wj))
-                .product();
-            for (o, d) in out.iter_mut().zip(di) {
-                *o += weight * d;
-            }
-        }
-        Some(out)
     }
 }

@@ -224,7 +224,7 @@ pub(crate) fn reduced_basis(
         v.set_column(last, &x);
         kept += 1;
     }
-    let projected = std::sync::Arc::new(super::system::project_structure(model, &v));
+    let projected = std::sync::Arc::new(crate::stability::system::project_structure(model, &v));
     let basis = Basis {
         v,
         modes: r,

@@ -1,4 +1,4 @@
-//! Which models the exponential flow ([`exponential`](super::exponential)) integrates exactly:
+//! Which models the exponential flow ([`exponential`](super::exp_flow)) integrates exactly:
 //! those whose every law is affine, `f = f0 + k u + d u̇` with constant `(f0, k, d)`, on each
 //! piece between its time jumps ([`ForceLaw::time_breakpoints`]) and its kinks
 //! ([`ForceLaw::kinks`]).

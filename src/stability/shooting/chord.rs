@@ -6,7 +6,7 @@
 //! method keeps a `J` of a nearby orbit (the previous point of a sweep, or the last Newton
 //! step) and converges linearly, at the rate `‖(J - I)⁻¹ (Φ̃ - J)‖`: a point of a sweep moves
 //! its orbit little, and a pass of the exponential flow without its monodromy matrix costs a
-//! fraction of one with it ([`record`](super::record)). A chord step that does not reduce the
+//! fraction of one with it ([`record`](crate::stability::exponential::record)). A chord step that does not reduce the
 //! scaled residual by [`CHORD_RATE`] is not counted against
 //! [`FloquetOptions::max_shooting`] and is followed by a Newton step (its `J` kept for the next
 //! chord steps); a chord step longer than `AHEAD_GAIN` times the residual (a kept `J` near a
@@ -19,11 +19,12 @@
 //! budget is spent (polished if `‖r̃‖∞ <= 1e3 rtol`); the multipliers are those of the monodromy
 //! matrix of the final orbit, formed for it.
 
-use super::integration::Integration;
-use super::shooting::{distance, Goal};
-use super::system::Coordinates;
-use super::FloquetOptions;
+use super::shoot::Goal;
 use crate::error::Result;
+use crate::stability::distance;
+use crate::stability::exponential::integration::Integration;
+use crate::stability::system::Coordinates;
+use crate::stability::FloquetOptions;
 use nalgebra::{DMatrix, DVector, Dyn, SVD};
 use num_complex::Complex64;
 
@@ -105,7 +106,7 @@ pub(crate) struct Outcome {
     /// the coordinates), the best guess of the periodic orbit's start for the next point of a
     /// sweep.
     pub(crate) ahead: Option<Vec<f64>>,
-    /// The sensitivity of the multipliers ([`Shot::kappa`](super::shooting::Shot::kappa)),
+    /// The sensitivity of the multipliers ([`Shot::kappa`](super::shoot::Shot::kappa)),
     /// measured when the first step was a Newton step.
     pub(crate) kappa: Option<f64>,
     /// Steps of flows given up for the Runge–Kutta flow.
@@ -144,7 +145,7 @@ fn pass_monodromy(
 /// (replaced by `runge_kutta()` where the exponential flow meets a law that is not affine),
 /// starting the chord steps with `jacobian` if given.
 /// The monodromy matrices of the exponential flow are multiplied on a second thread where
-/// there is one ([`pipeline`](super::pipeline)).
+/// there is one ([`pipeline`](crate::stability::exponential::pipeline)).
 pub(crate) fn iterate<'c, 'm>(
     problem: &Problem,
     flow: &mut Integration<'c, 'm>,

@@ -38,56 +38,56 @@ use super::generator::{Core, Expansion, Forcing, State};
 use super::kept::{Cores, KeptGenerators, WordMap};
 use super::kernels::gemv_sum;
 use super::kinks::Kinked;
-use super::pieces::Pieces;
 use super::pipeline::{Link, Message};
 use super::record::{Assembler, Step};
-use super::system::Coordinates;
 use crate::error::{Error, Result};
+use crate::stability::integrated::pieces::Pieces;
+use crate::stability::system::Coordinates;
 use nalgebra::{DMatrix, DVector};
 
 /// The flow over one period by exponentials.
 pub(crate) struct ExpFlow<'c, 'm> {
-    pub(super) sys: &'c Coordinates<'m>,
-    pub(super) n: usize,
-    pub(super) omega: f64,
-    pub(super) bounds: Vec<f64>,
-    pub(super) pieces: Pieces,
-    pub(super) scale_q: f64,
-    pub(super) scale_v: f64,
+    pub(crate) sys: &'c Coordinates<'m>,
+    pub(crate) n: usize,
+    pub(crate) omega: f64,
+    pub(crate) bounds: Vec<f64>,
+    pub(crate) pieces: Pieces,
+    pub(crate) scale_q: f64,
+    pub(crate) scale_v: f64,
     /// The sub-step δ₀ (a power of two).
-    pub(super) delta0: f64,
+    pub(crate) delta0: f64,
     max_steps: usize,
     /// `Ã` of the structure alone.
     base: DMatrix<f64>,
     /// `M⁻¹ w_e` (unscaled).
-    pub(super) mw: Vec<DVector<f64>>,
+    pub(crate) mw: Vec<DVector<f64>>,
     forcing: Forcing,
     /// The oscillator's turn over δ₀.
     turns: Vec<(f64, f64)>,
     work: ExpWork,
     /// The generators met so far, and their index by the laws' coefficients.
-    pub(super) states: Vec<State>,
+    pub(crate) states: Vec<State>,
     /// Their cores, kept from the last analysis or formed here.
     cores: Cores,
-    pub(super) index: WordMap<Vec<u64>, usize>,
+    pub(crate) index: WordMap<Vec<u64>, usize>,
     /// The Taylor series of the exact solution from the last expansion point.
-    pub(super) taylor: Expansion,
+    pub(crate) taylor: Expansion,
     /// The elements with kinks.
-    pub(super) kinks: Kinked,
+    pub(crate) kinks: Kinked,
     /// Integration steps (sub-steps and remainders) over all periods.
     pub(crate) steps: usize,
     /// The monodromy side, here or (linked) on another thread.
-    pub(super) assembler: Box<Assembler>,
-    pub(super) link: Option<Box<Link>>,
+    pub(crate) assembler: Box<Assembler>,
+    pub(crate) link: Option<Box<Link>>,
     /// The orbit is not integrated ([`ExpFlow::along_harmonics`]): the generators' states
     /// leave out the load's part `X_δ₀`.
-    pub(super) monodromy_only: bool,
+    pub(crate) monodromy_only: bool,
 }
 
 /// A piece: its generator and the laws' coefficients `(f0_e, k_e, d_e)`.
-pub(super) struct Piece {
-    pub(super) state: usize,
-    pub(super) coefficients: Vec<(f64, f64, f64)>,
+pub(crate) struct Piece {
+    pub(crate) state: usize,
+    pub(crate) coefficients: Vec<(f64, f64, f64)>,
 }
 
 impl<'c, 'm> ExpFlow<'c, 'm> {
@@ -162,7 +162,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
     }
 
     /// The piece the scaled state `x̃` is in, laws evaluated at angle `theta`.
-    pub(super) fn piece(&mut self, theta: f64) -> Piece {
+    pub(crate) fn piece(&mut self, theta: f64) -> Piece {
         let n = self.n;
         let mut coefficients = Vec::with_capacity(self.mw.len());
         let mut key = Vec::with_capacity(3 * self.mw.len());
@@ -226,7 +226,7 @@ impl<'c, 'm> ExpFlow<'c, 'm> {
 
     /// `true` if every law `e` at `theta` and `state(e) = (u, u̇)` has the piece's
     /// coefficients (to 1e-9).
-    pub(super) fn coefficients_hold(
+    pub(crate) fn coefficients_hold(
         &self,
         piece: &Piece,
         theta: f64,

@@ -1,4 +1,4 @@
-//! The record of a pass of the exponential flow ([`exponential`](super::exponential)) and the
+//! The record of a pass of the exponential flow ([`exponential`](super::exp_flow)) and the
 //! monodromy matrix from it.
 //!
 //! The orbit and its monodromy matrix are separate: a pass integrates the state only and
@@ -11,16 +11,16 @@
 //! (`E^m = e^{Ãmδ₀}` and `e^{Ãτ}` per generator from its [`Propagator`], `S` the saltation
 //! matrices), multiplied by the [`Assembler`] step by step in the pass's order. Only the
 //! orbits whose monodromy matrix is used pay for it: the shooting's Newton–chord iterations
-//! ([`chord`](super::chord)) need it once per point.
+//! ([`chord`](crate::stability::shooting::chord)) need it once per point.
 
+use super::exp_flow::ExpFlow;
 use super::expm::ExpWork;
-use super::exponential::ExpFlow;
 use super::generator::Core;
 use super::kernels::product;
-use super::pieces::saltation;
 use super::pipeline::{Link, Message};
 use super::propagator::Propagator;
 use crate::error::{Error, Result};
+use crate::stability::integrated::pieces::saltation;
 use nalgebra::{DMatrix, DVector};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -35,7 +35,7 @@ pub(crate) enum Step {
         tau: f64,
     },
     /// `δṽ += c M⁻¹ w_e (w̃_e·δq̃)` in every column: the saltation matrix of a force jump of
-    /// element `e` ([`Pieces::cross_jump`](super::pieces::Pieces::cross_jump)).
+    /// element `e` ([`Pieces::cross_jump`](crate::stability::integrated::pieces::Pieces::cross_jump)).
     Jump { element: usize, factor: f64 },
 }
 
@@ -138,7 +138,7 @@ impl Assembler {
 
 impl ExpFlow<'_, '_> {
     /// Appends `step` to `record` (and sends it to a linked assembler).
-    pub(super) fn emit(&mut self, record: &mut Vec<Step>, step: Step) {
+    pub(crate) fn emit(&mut self, record: &mut Vec<Step>, step: Step) {
         if let Some(link) = &mut self.link {
             link.step(step);
         }

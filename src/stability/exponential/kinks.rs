@@ -1,12 +1,12 @@
-//! Kink crossings of the exponential flow ([`exponential`](super::exponential)): the elements'
+//! Kink crossings of the exponential flow ([`exponential`](super::exp_flow)): the elements'
 //! `(u, u̇)` at the end of every sub-step, the first crossing inside it from the cubic Hermite
-//! interpolant ([`Pieces::crossing`](super::pieces::Pieces::crossing)), its time by Newton on
+//! interpolant ([`Pieces::crossing`](crate::stability::integrated::pieces::Pieces::crossing)), its time by Newton on
 //! the Taylor series of the exact solution, and the saltation factor of the force jump there.
 
-use super::exponential::ExpFlow;
+use super::exp_flow::ExpFlow;
 use super::kernels::gemv;
-use super::pieces::{stays_inside, widened, Pieces};
-use super::system::Coordinates;
+use crate::stability::integrated::pieces::{stays_inside, widened, Pieces};
+use crate::stability::system::Coordinates;
 use nalgebra::{DMatrix, DVector};
 
 /// The elements with kinks and the rows that give their `(u, u̇)` from the scaled state.
@@ -57,7 +57,7 @@ impl Kinked {
 
 impl ExpFlow<'_, '_> {
     /// `(u, u̇)` of element `e` at the scaled state `x̃`.
-    pub(super) fn element_state(&self, e: usize, x: &DVector<f64>) -> (f64, f64) {
+    pub(crate) fn element_state(&self, e: usize, x: &DVector<f64>) -> (f64, f64) {
         let n = self.n;
         let sys = self.sys;
         (
@@ -68,7 +68,7 @@ impl ExpFlow<'_, '_> {
 
     /// `(u_j, u̇_j)` of the elements with kinks at the scaled state `x̃`, interleaved in
     /// `out` (`2K` values): one product with the rows `(s_q w̃_e, 0)`, `(0, s_v w̃_e)`.
-    pub(super) fn kink_states(&self, x: &DVector<f64>, out: &mut [f64]) {
+    pub(crate) fn kink_states(&self, x: &DVector<f64>, out: &mut [f64]) {
         if !out.is_empty() {
             gemv(&self.kinks.rows, x.as_slice(), out, false);
         }
@@ -76,7 +76,7 @@ impl ExpFlow<'_, '_> {
 
     /// The earliest kink crossing over a time `h` with the kinked elements' `(u, u̇)` going
     /// from `start` to `end` ([`ExpFlow::kink_states`]): `(fraction, element, upwards?)`.
-    pub(super) fn first_crossing(
+    pub(crate) fn first_crossing(
         &self,
         start: &[f64],
         end: &[f64],
@@ -102,7 +102,7 @@ impl ExpFlow<'_, '_> {
 
     /// The time `τ <= h` after the expansion point at which element `e`'s `u` reaches the
     /// edge of its piece (Newton from `guess`); `x` becomes the state there.
-    pub(super) fn locate(
+    pub(crate) fn locate(
         &self,
         x: &mut DVector<f64>,
         guess: f64,
@@ -127,8 +127,8 @@ impl ExpFlow<'_, '_> {
     }
 
     /// Moves element `e` across its kink at angle `theta` with the scaled state `x̃`: the
-    /// factor of the saltation matrix of its force jump ([`Pieces::cross_jump`](super::pieces::Pieces::cross_jump)).
-    pub(super) fn cross(
+    /// factor of the saltation matrix of its force jump ([`Pieces::cross_jump`](crate::stability::integrated::pieces::Pieces::cross_jump)).
+    pub(crate) fn cross(
         &mut self,
         e: usize,
         up: bool,

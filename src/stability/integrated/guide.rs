@@ -1,7 +1,7 @@
 //! The HB orbit as the path of the Runge–Kutta flow: the variational equation along the HB
 //! solution itself, for laws that are not affine between their kinks (a cosine or Fourier
 //! mesh stiffness under backlash, smooth nonlinear springs), where the exponential flow's
-//! pieces ([`harmonic_orbit`](super::harmonic_orbit)) do not apply.
+//! pieces ([`harmonic_orbit`](crate::stability::harmonic_orbit)) do not apply.
 //!
 //! With `q_H(t) = Re Σ_{k=0}^{H} Q_k e^{ikθ}`, `θ = ω t` (`ω` the fundamental `Ω/ν`), the flow
 //! integrates `q̇ = v`, `v̇ = a_H(t)` with `a_H(t) = Re Σ_{k≥1} −(kω)² Q_k e^{ikθ}` from the HB
@@ -12,7 +12,7 @@
 //! ([`flow`](super::flow)). The multipliers are those of the linearisation about the HB
 //! solution (Hill's method's), accurate to about its own error: what a strongly unstable
 //! orbit needs, whose unstable direction single shooting cannot hold
-//! ([`orbit_identity`](super::orbit_identity)).
+//! ([`orbit_identity`](crate::stability::choice::orbit_identity)).
 
 use num_complex::Complex64;
 
