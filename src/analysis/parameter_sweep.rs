@@ -227,21 +227,26 @@ impl ParameterSweepAnalysis {
 
     /// The JSON record (what `Serialize` writes).
     pub fn to_json(&self) -> Value {
-        let points: Vec<Value> = self.branch.points.iter().map(|p| {
-            let f = p.floquet.as_ref();
-            json!({
-                "parameter": p.parameter,
-                "stable": p.stable(),
-                "bifurcation": p.bifurcation.map(|b| format!("{b:?}")),
-                "max_abs": p.max_abs,
-                "residual": p.residual,
-                "truncation": p.truncation,
-                "multipliers": f.map(|f| f.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>()),
-                "multipliers_abs": f.map(|f| f.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>()),
-                "neutral": f.map(|f| f.neutral),
-                "orbit_correction": f.map(|f| f.orbit_correction),
+        let points: Vec<Value> = self
+            .branch
+            .points
+            .iter()
+            .map(|p| {
+                let f = p.floquet.as_ref();
+                json!({
+                    "parameter": p.parameter,
+                    "stable": p.stable(),
+                    "bifurcation": p.bifurcation.map(|b| format!("{b:?}")),
+                    "max_abs": p.max_abs,
+                    "residual": p.residual,
+                    "truncation": p.truncation,
+                    "multipliers": f.map(|f| f.pairs()),
+                    "multipliers_abs": f.map(|f| f.moduli()),
+                    "neutral": f.map(|f| f.neutral),
+                    "orbit_correction": f.map(|f| f.orbit_correction),
+                })
             })
-        }).collect();
+            .collect();
         let b = &self.branch;
         json!({
             "schema_version": super::SCHEMA_VERSION,

@@ -100,6 +100,16 @@ impl Floquet {
         distance(&self.multipliers, &other.multipliers)
     }
 
+    /// The multipliers as `[re, im]` pairs, largest modulus first (their JSON form).
+    pub fn pairs(&self) -> Vec<[f64; 2]> {
+        self.multipliers.iter().map(|m| [m.re, m.im]).collect()
+    }
+
+    /// The multipliers' moduli `|μ|`, largest first.
+    pub fn moduli(&self) -> Vec<f64> {
+        self.multipliers.iter().map(|m| m.norm()).collect()
+    }
+
     /// `true` if every multiplier lies inside the unit circle: `max |μ| <= 1 +`
     /// [`STABILITY_MARGIN`].
     pub fn is_stable(&self) -> bool {

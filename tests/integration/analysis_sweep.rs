@@ -5,7 +5,7 @@
 //! observer.
 
 use crate::analysis_solve::scenes;
-use crate::common::json_diff::{first_difference, without_times};
+use crate::common::json_diff::difference_without_times;
 use hbal::analysis::{sweep, Observer, Silent, SweepSettings};
 use hbal::continuation::{BranchStop, Cancel};
 use hbal::scene::Scene;
@@ -33,9 +33,7 @@ fn library_equals_cli(path: &Path, max_points: usize) {
     let name = path.display();
     let mut cli: Value =
         serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{name}: {e}"));
-    without_times(&mut library);
-    without_times(&mut cli);
-    if let Some(d) = first_difference(&library, &cli, "") {
+    if let Some(d) = difference_without_times(&mut library, &mut cli) {
         panic!("{name}: {d}");
     }
     assert_eq!(cli["schema_version"], 1, "{name}");
@@ -227,9 +225,7 @@ fn the_parameter_sweep_runs_in_the_library() {
         .output()
         .unwrap();
     let mut cli: Value = serde_json::from_slice(&out.stdout).unwrap();
-    without_times(&mut library);
-    without_times(&mut cli);
-    assert_eq!(first_difference(&library, &cli, ""), None);
+    assert_eq!(difference_without_times(&mut library, &mut cli), None);
     assert_eq!(cli["schema_version"], 1);
     // The response grows with the load.
     let m: Vec<f64> = a.branch.points.iter().map(|p| p.max_abs[0]).collect();
@@ -311,8 +307,10 @@ fn the_library_example_prints_what_the_cli_prints() {
     ]) {
         let mut mine: Value = serde_json::from_str(line).unwrap();
         let mut theirs = cli(&args);
-        without_times(&mut mine);
-        without_times(&mut theirs);
-        assert_eq!(first_difference(&mine, &theirs, ""), None, "{args:?}");
+        assert_eq!(
+            difference_without_times(&mut mine, &mut theirs),
+            None,
+            "{args:?}"
+        );
     }
 }

@@ -34,3 +34,10 @@ pub fn first_difference(a: &Value, b: &Value, path: &str) -> Option<String> {
         _ => Some(format!("{path}: {a} vs {b}")),
     }
 }
+
+/// The first difference between `a` and `b` once both lose their wall times.
+pub fn difference_without_times(a: &mut Value, b: &mut Value) -> Option<String> {
+    without_times(a);
+    without_times(b);
+    first_difference(a, b, "")
+}
