@@ -72,10 +72,10 @@ impl DynamicStiffness {
             let relative_pivot = if scale > 0.0 { min_pivot / scale } else { 0.0 };
             if relative_pivot <= SINGULAR_PIVOT {
                 let hint = if k == 0 {
-                    "K0 is singular, but not by a free rigid-body mode (free-free models are \
-                     handled): a motion held only by damping to ground or by an element \
-                     without linear stiffness, or a massless DOF; ground it with a stiffness \
-                     or fix the DOF"
+                    "K0 is singular, but not by a rigid-body mode (free-free models and motions \
+                     held only by damping to ground are handled): a motion held only by an \
+                     element without linear stiffness, or a massless DOF; ground it with a \
+                     stiffness or fix the DOF"
                         .to_string()
                 } else {
                     format!(

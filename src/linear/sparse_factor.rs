@@ -207,7 +207,7 @@ impl SparseDynamicStiffness {
 /// The error of a singular `Z_k` at frequency `w`.
 fn singular(k: usize, w: f64, relative_pivot: f64) -> Error {
     let hint = if k == 0 {
-        "K0 is singular, but not by a free rigid-body mode (free-free models are handled): a motion held only by damping to ground or by an element without linear stiffness, or a massless DOF; ground it with a stiffness or fix the DOF"
+        "K0 is singular, but not by a rigid-body mode (free-free models and motions held only by damping to ground are handled): a motion held only by an element without linear stiffness, or a massless DOF; ground it with a stiffness or fix the DOF"
             .to_string()
     } else {
         format!(

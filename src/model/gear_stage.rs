@@ -62,7 +62,8 @@ pub struct GearStage {
     /// Revolutions of the driving gear per revolution of the reference shaft (default 1): a
     /// stage behind a ratio 2.5 from the engine has `shaft_order = 0.4`. The mesh runs
     /// `z1 · shaft_order / f` cycles per period of a fundamental of order `f`
-    /// (`fundamental_order`), which must be a whole number.
+    /// (`fundamental_order`), which must be a whole number where the mesh stiffness varies
+    /// (any with a constant stiffness, which has no mesh order).
     #[serde(default = "one")]
     pub shaft_order: f64,
     /// The order `f` of the fundamental relative to the reference shaft (default 1; a scene
@@ -195,8 +196,11 @@ impl GearStage {
         crate::force::check_teeth(context, self.teeth)?;
         check_positive(context, "shaft_order", self.shaft_order)?;
         check_positive(context, "fundamental_order", self.fundamental_order)?;
+        // A constant mesh stiffness does not vary with the mesh cycle: any real ratio and
+        // shaft order (the marine line's 9.4094), the mesh order is not a harmonic.
         let z = self.mesh_cycles();
-        if z > MAX_TEETH as f64 + 0.5 {
+        let varies = self.stiffness.time_order(1).is_some();
+        if varies && z > MAX_TEETH as f64 + 0.5 {
             return Err(Error::invalid(
                 context,
                 "shaft_order",
@@ -210,7 +214,7 @@ impl GearStage {
                 ),
             ));
         }
-        if self.mesh_order().is_none() {
+        if varies && self.mesh_order().is_none() {
             return Err(Error::invalid(
                 context,
                 "shaft_order",

@@ -1,10 +1,15 @@
 //! Rigid-body modes of a free-free model and the static problem in their complement.
 //!
 //! A free-free drivetrain (driven by a torque, loaded by a torque, no spring to ground) has
-//! rigid-body modes `r`: `K r = 0`, `D r = 0` and `w_e·r = 0` for every element (for gear
-//! stages, the rigid rotation compatible with the ratios). Then `K0 r = 0`, `D0 r = 0`, and
-//! the static harmonic `Z_0 = K0` is singular. Harmonics `k >= 1` keep their mass and are
-//! regular.
+//! rigid-body modes `r`: `K r = 0` and `w_e·r = 0` for every element (for gear stages, the
+//! rigid rotation compatible with the ratios). Then `K0 r = 0` and the static harmonic
+//! `Z_0 = K0` is singular. Harmonics `k >= 1` keep their mass and are regular. Damping does
+//! not enter `Z_0`: a motion that only damping to ground holds (a propeller damper, dampers
+//! at the crank throws, modal damping whose rigid-mode rounding is not zero) leaves `Z_0` as
+//! singular as a free one, and harmonic 0 is solved in the complement of both kinds. They
+//! differ in their dynamics: a free mode (`D r = 0` too) drifts at any constant speed, two
+//! multipliers 1; one held by damping comes to rest, one multiplier 1
+//! ([`RigidModes::free`], [`RigidModes::held`]).
 //!
 //! **Balance.** `K0 q_0 = f_0` has a solution only if `Rᵀ f_0 = 0`: the mean loads must do no
 //! work on a rigid rotation, else the drivetrain accelerates and there is no periodic
@@ -41,11 +46,14 @@ pub const BALANCE_TOLERANCE: f64 = 1e-8;
 /// and the same for `D` and every element's `w·x`.
 const FREE_TOLERANCE: f64 = 1e-9;
 
-/// The rigid-body modes `R` (n × p, `Rᵀ M R = I`) of a model, with `M R`.
+/// The rigid-body modes `R` (n × p, `Rᵀ M R = I`) of a model, with `M R`: the free ones
+/// first, then those held only by damping.
 #[derive(Debug, Clone)]
 pub struct RigidModes {
     modes: DMatrix<f64>,
     mass_modes: DMatrix<f64>,
+    /// How many of the first columns are free (`D r = 0`).
+    free: usize,
     /// `‖K0‖/‖M‖` (max entries), a squared frequency inside the model's spectrum.
     scale: f64,
 }
@@ -92,7 +100,7 @@ impl RigidModes {
             let eig = ((&a + a.transpose()) * 0.5).symmetric_eigen();
             let free: Vec<_> = (0..p)
                 .map(|i| &x * (l_inv.transpose() * eig.eigenvectors.column(i)))
-                .filter(|v| is_free(model, v.as_slice()))
+                .filter(|v| is_static_free(model, v.as_slice()))
                 .collect();
             if free.len() == p && p < n {
                 p = (2 * p).min(n);
@@ -129,11 +137,24 @@ impl RigidModes {
                 mcols.push(mv / norm);
             }
         }
+        let (modes, mass_modes) = (DMatrix::from_columns(&cols), DMatrix::from_columns(&mcols));
+        let (modes, mass_modes, free) = split_by_damping(model, modes, mass_modes);
         Self {
-            modes: DMatrix::from_columns(&cols),
-            mass_modes: DMatrix::from_columns(&mcols),
+            modes,
+            mass_modes,
+            free,
             scale: stiffness_scale(model),
         }
+    }
+
+    /// The free modes (`D r = 0`: two multipliers 1 each).
+    pub fn free(&self) -> usize {
+        self.free
+    }
+
+    /// The modes held only by damping (`D r ≠ 0`: one multiplier 1 each, the position).
+    pub fn held(&self) -> usize {
+        self.len() - self.free
     }
 
     /// Number of rigid-body modes p.
@@ -256,26 +277,53 @@ fn sparse_times(a: &super::SparseMatrix, v: &DMatrix<f64>) -> DMatrix<f64> {
     out
 }
 
+/// `R Y`, `M R Y` with `Y` the eigenvectors of `Rᵀ D R` (orthogonal: still M-orthonormal),
+/// the free ones ([`is_free`]) first, and their count.
+fn split_by_damping(
+    model: &Model,
+    modes: DMatrix<f64>,
+    mass_modes: DMatrix<f64>,
+) -> (DMatrix<f64>, DMatrix<f64>, usize) {
+    let dr = sparse_times(model.structural_damping(), &modes);
+    let h = modes.transpose() * dr;
+    let eig = ((&h + h.transpose()) * 0.5).symmetric_eigen();
+    let (rotated, mass_rotated) = (&modes * &eig.eigenvectors, &mass_modes * &eig.eigenvectors);
+    let (free, held): (Vec<usize>, Vec<usize>) =
+        (0..modes.ncols()).partition(|&c| is_free(model, rotated.column(c).as_slice()));
+    let order: Vec<usize> = free.iter().chain(&held).copied().collect();
+    let pick = |a: &DMatrix<f64>| DMatrix::from_fn(a.nrows(), order.len(), |i, c| a[(i, order[c])]);
+    (pick(&rotated), pick(&mass_rotated), free.len())
+}
+
+/// `true` if `a x` is rounding against `a`'s largest entry and `x`'s (`scale`).
+fn leaves_alone(a: &super::SparseMatrix, x: &[f64], scale: f64) -> bool {
+    let top = a.amax();
+    if top == 0.0 {
+        return true;
+    }
+    let mut y = vec![0.0; x.len()];
+    a.mul_add(1.0, x, &mut y);
+    y.iter().all(|v| v.abs() <= FREE_TOLERANCE * top * scale)
+}
+
 /// `true` if nothing restrains the motion `x` beyond rounding, measured on the matrices
 /// themselves (`K`, `D`, every element's weights). Unsquared, so a soft ground spring on a
 /// long stiff chain (500 N m/rad against 1e9 N m/rad shaft elements) is told apart from a
 /// rigid-body mode (5e-7 against 1e-15).
 pub(crate) fn is_free(model: &Model, x: &[f64]) -> bool {
     let scale = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    is_static_free(model, x) && leaves_alone(model.structural_damping(), x, scale)
+}
+
+/// `true` if no stiffness and no element restrains the motion `x` beyond rounding (damping
+/// may): a motion harmonic 0 cannot fix, as [`is_free`] without `D`.
+pub(crate) fn is_static_free(model: &Model, x: &[f64]) -> bool {
+    let scale = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     if scale == 0.0 || !scale.is_finite() {
         return false;
     }
-    let mut y = vec![0.0; x.len()];
-    for a in [model.structural_stiffness(), model.structural_damping()] {
-        let top = a.amax();
-        if top == 0.0 {
-            continue;
-        }
-        y.fill(0.0);
-        a.mul_add(1.0, x, &mut y);
-        if y.iter().any(|v| v.abs() > FREE_TOLERANCE * top * scale) {
-            return false;
-        }
+    if !leaves_alone(model.structural_stiffness(), x, scale) {
+        return false;
     }
     model.elements().iter().all(|e| {
         let top = e

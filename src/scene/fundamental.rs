@@ -99,10 +99,18 @@ impl Fundamental {
     }
 }
 
-/// `teeth × shaft_order` of a `gear_stage` table, read leniently (the stage's own check
-/// reports bad values).
+/// `teeth × shaft_order` of a `gear_stage` table whose stiffness varies with the mesh cycle,
+/// read leniently (the stage's own check reports bad values); `None` for a constant
+/// stiffness, which has no mesh order.
 fn stage_mesh_order(e: &Map<String, Value>) -> Option<f64> {
     if e.get("type").and_then(Value::as_str) != Some("gear_stage") {
+        return None;
+    }
+    let shape = e
+        .get("stiffness")
+        .and_then(|s| s.get("shape"))
+        .and_then(Value::as_str);
+    if shape == Some("constant") {
         return None;
     }
     let teeth = e.get("teeth")?.as_f64()?;

@@ -1,28 +1,66 @@
-//! Neutral modes: rigid-body motions that no stiffness, damping or element restrains.
+//! Neutral modes: rigid-body motions that no stiffness or element restrains.
 //!
 //! A vector `r` with `K r = 0`, `D r = 0` and `w_e·r = 0` for every element moves freely: the
 //! variational equation has the solutions `(δq, δq̇) = (r, 0)` and `(t r, r)`, so the monodromy
 //! matrix has the invariant subspace `V = span{(r, 0), (0, r)}` with the double multiplier 1
-//! (`Φ (0, r) = (T r, r)`). These multipliers are 1 by construction and say nothing about
-//! stability. In an orthonormal basis `[V W]` the monodromy matrix is block upper triangular,
-//! and the multipliers that decide stability are those of `Wᵀ Φ W`.
+//! (`Φ (0, r) = (T r, r)`). A motion held only by damping to ground (`K r = 0`, `w_e·r = 0`,
+//! `D r ≠ 0`) keeps the position solution `(r, 0)` alone: `V = span{(r, 0)}`, one multiplier
+//! 1; its velocity decays and stays among the multipliers. These multipliers are 1 by
+//! construction and say nothing about stability. In an orthonormal basis `[V W]` the
+//! monodromy matrix is block upper triangular, and the multipliers that decide stability are
+//! those of `Wᵀ Φ W`.
 
 use super::system::Coordinates;
-use crate::model::rigid::is_free;
+use crate::model::rigid::{is_free, is_static_free};
 use nalgebra::DMatrix;
 
-/// Orthonormal basis (columns) of the rigid-body modes in the coordinates `sys`.
-pub(crate) fn rigid_body_modes(sys: &Coordinates) -> DMatrix<f64> {
-    match &sys.basis {
+/// The rigid-body modes in some coordinates: orthonormal columns, the free ones first.
+pub(crate) struct NeutralModes {
+    /// Every motion no stiffness and no element restrains.
+    pub(crate) modes: DMatrix<f64>,
+    /// How many of the first columns damping does not hold either.
+    pub(crate) free: usize,
+}
+
+impl NeutralModes {
+    /// The multipliers that are 1 by construction: two per free mode, one per held one.
+    pub(crate) fn multipliers(&self) -> usize {
+        self.modes.ncols() + self.free
+    }
+}
+
+/// The rigid-body modes in the coordinates `sys`.
+pub(crate) fn rigid_body_modes(sys: &Coordinates) -> NeutralModes {
+    let modes = match &sys.basis {
         None => in_dofs(sys),
         Some(v) => on_basis(sys, v),
+    };
+    split_by_damping(sys, modes)
+}
+
+/// `S Y` for the eigenvectors `Y` of `Sᵀ D S` (still orthonormal), those free in the model's
+/// DOFs ([`is_free`]) first.
+fn split_by_damping(sys: &Coordinates, s: DMatrix<f64>) -> NeutralModes {
+    if s.ncols() == 0 {
+        return NeutralModes { modes: s, free: 0 };
+    }
+    let h = s.transpose() * &sys.damping * &s;
+    let eig = ((&h + h.transpose()) * 0.5).symmetric_eigen();
+    let rotated = &s * &eig.eigenvectors;
+    let (free, held): (Vec<usize>, Vec<usize>) = (0..rotated.ncols())
+        .partition(|&c| is_free(sys.model, &sys.lift(rotated.column(c).as_slice())));
+    let order: Vec<usize> = free.iter().chain(&held).copied().collect();
+    let modes = DMatrix::from_fn(rotated.nrows(), order.len(), |i, c| rotated[(i, order[c])]);
+    NeutralModes {
+        modes,
+        free: free.len(),
     }
 }
 
 /// The rigid-body modes in the model's DOFs.
 fn in_dofs(sys: &Coordinates) -> DMatrix<f64> {
     let n = sys.len();
-    // G = [K/|K|; D/|D|; w_eᵀ/|w_e|]; its null space is the set of free motions.
+    // G = [K/|K|; w_eᵀ/|w_e|]; its null space is the set of motions harmonic 0 cannot fix.
     let mut g = DMatrix::<f64>::zeros(n, n);
     let mut add_rows = |rows: &DMatrix<f64>| {
         let norm = rows.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
@@ -31,7 +69,6 @@ fn in_dofs(sys: &Coordinates) -> DMatrix<f64> {
         }
     };
     add_rows(&sys.stiffness);
-    add_rows(&sys.damping);
     for weights in &sys.weights {
         let mut w = DMatrix::<f64>::zeros(1, n);
         for &(i, wi) in weights {
@@ -46,7 +83,7 @@ fn in_dofs(sys: &Coordinates) -> DMatrix<f64> {
         .collect();
     let free: Vec<usize> = free
         .into_iter()
-        .filter(|&i| is_free(sys.model, eig.eigenvectors.column(i).as_slice()))
+        .filter(|&i| is_static_free(sys.model, eig.eigenvectors.column(i).as_slice()))
         .collect();
     let mut r = DMatrix::zeros(n, free.len());
     for (c, &i) in free.iter().enumerate() {
@@ -68,9 +105,8 @@ fn on_basis(sys: &Coordinates, v: &DMatrix<f64>) -> DMatrix<f64> {
             g += rows.transpose() * rows / (norm * norm);
         }
     };
-    for a in [model.structural_stiffness(), model.structural_damping()] {
-        add_rows(&super::system::sparse_times(a, v), a.amax());
-    }
+    let k = model.structural_stiffness();
+    add_rows(&super::system::sparse_times(k, v), k.amax());
     for e in model.elements() {
         let w = DMatrix::from_fn(1, r, |_, j| {
             e.weights().iter().map(|&(i, wi)| wi * v[(i, j)]).sum()
@@ -99,7 +135,7 @@ fn on_basis(sys: &Coordinates, v: &DMatrix<f64>) -> DMatrix<f64> {
     let columns: Vec<_> = free
         .iter()
         .map(|&i| l_inv.transpose() * eig.eigenvectors.column(i))
-        .filter(|y| is_free(model, (v * y).as_slice()))
+        .filter(|y| is_static_free(model, (v * y).as_slice()))
         .collect();
     if columns.is_empty() {
         return DMatrix::zeros(r, 0);
@@ -123,17 +159,21 @@ pub(crate) fn complement(v: &DMatrix<f64>, m: usize) -> DMatrix<f64> {
     w
 }
 
-/// The state-space bases for rigid-body modes `r` (n × p): `(positions, all)` with
-/// `positions = [(r, 0)]` and `all = [(r, 0), (0, r)]`, both orthonormal in `R^{2n}`.
-pub(crate) fn state_bases(r: &DMatrix<f64>) -> (DMatrix<f64>, DMatrix<f64>) {
+/// The state-space bases for rigid-body modes `r` (n × p, the first `f` free):
+/// `(positions, all)` with `positions = [(r, 0)]` and `all = [(r, 0), (0, r_free)]`, both
+/// orthonormal in `R^{2n}`: `all` spans the invariant subspace of the multipliers 1.
+pub(crate) fn state_bases(neutral: &NeutralModes) -> (DMatrix<f64>, DMatrix<f64>) {
+    let r = &neutral.modes;
     let (n, p) = r.shape();
     let mut pos = DMatrix::zeros(2 * n, p);
-    let mut all = DMatrix::zeros(2 * n, 2 * p);
+    let mut all = DMatrix::zeros(2 * n, p + neutral.free);
     for c in 0..p {
         for i in 0..n {
             pos[(i, c)] = r[(i, c)];
             all[(i, c)] = r[(i, c)];
-            all[(n + i, p + c)] = r[(i, c)];
+            if c < neutral.free {
+                all[(n + i, p + c)] = r[(i, c)];
+            }
         }
     }
     (pos, all)
@@ -186,8 +226,9 @@ mod tests {
             )
             .build()
             .unwrap();
-        let r = rigid_body_modes(&Coordinates::full(&model));
-        assert_eq!(r.ncols(), 1);
+        let neutral = rigid_body_modes(&Coordinates::full(&model));
+        assert_eq!((neutral.modes.ncols(), neutral.free), (1, 1));
+        let r = neutral.modes;
         assert!((r[(0, 0)] - r[(1, 0)]).abs() < 1e-12);
         let grounded = Model::builder(&["a", "b"])
             .mass_diagonal(&[1.0, 2.0])
@@ -199,7 +240,8 @@ mod tests {
             .element("ground", &[("a", 1.0)], LinearSpring::new(1e-9, 0.0))
             .build()
             .unwrap();
-        assert_eq!(rigid_body_modes(&Coordinates::full(&grounded)).ncols(), 0);
+        let grounded = rigid_body_modes(&Coordinates::full(&grounded));
+        assert_eq!(grounded.modes.ncols(), 0);
         let w = complement(&r, 2);
         assert_eq!(w.ncols(), 1);
         assert!((w.column(0).dot(&r.column(0))).abs() < 1e-12);

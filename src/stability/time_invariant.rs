@@ -98,7 +98,8 @@ pub(crate) fn eigenvalues(model: &Model) -> Result<Option<Vec<Complex64>>> {
 /// less than the shooting it replaces).
 const MAX_DOFS: usize = 1000;
 
-/// The eigenvalues of `A` without the `2r` of the rigid-body modes; `None` if `M` is not
+/// The eigenvalues of `A` without the zeros of the rigid-body modes (two per free mode, one per
+/// mode held only by damping); `None` if `M` is not
 /// positive definite.
 fn state_eigenvalues(model: &Model, id: u64) -> Result<Option<StateEigenvalues>> {
     let n = model.n_dofs();
@@ -122,7 +123,7 @@ fn state_eigenvalues(model: &Model, id: u64) -> Result<Option<StateEigenvalues>>
     {
         return Ok(None);
     }
-    let neutral = 2 * rigid_body_modes(&Coordinates::full(model)).ncols();
+    let neutral = rigid_body_modes(&Coordinates::full(model)).multipliers();
     lambdas.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
     lambdas.drain(..neutral.min(lambdas.len()));
     Ok(Some(StateEigenvalues {

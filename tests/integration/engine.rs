@@ -298,7 +298,7 @@ driven = \"flywheel\"
 base_radii = [0.02, 0.04]
 teeth = 21
 shaft_order = 0.5
-stiffness = {{ shape = \"constant\", stiffness = 1e8 }}
+stiffness = {{ shape = \"cosine\", mean = 1e8, amplitude = 1e7 }}
 "
     )
     .replace(

@@ -161,17 +161,15 @@ fn scene_gear_stage_equals_the_generic_mesh_element() {
 }
 
 /// A second stage behind a ratio 2.5 under an engine-speed fundamental runs at
-/// `shaft_order = 0.4`: 20 teeth give mesh order 8; 21 teeth (8.4) are refused.
+/// `shaft_order = 0.4`: 20 teeth give mesh order 8; 21 teeth (8.4) are refused where the
+/// stiffness varies with the mesh cycle, accepted where it is constant (no mesh order).
 #[test]
 fn shaft_order_sets_the_mesh_order() {
-    let stage = GearStage::new(
-        "a",
-        "b",
-        [0.02, 0.05],
-        20,
-        MeshProfile::Constant { stiffness: 1e8 },
-    )
-    .with_shaft_order(0.4);
+    let cosine = MeshProfile::Cosine {
+        mean: 1e8,
+        amplitude: 1e7,
+    };
+    let stage = GearStage::new("a", "b", [0.02, 0.05], 20, cosine).with_shaft_order(0.4);
     assert_eq!(stage.mesh_order(), Some(8));
     let mut bad = stage.clone();
     bad.teeth = 21;
@@ -180,6 +178,45 @@ fn shaft_order_sets_the_mesh_order() {
     assert!(
         err.contains("shaft_order") && err.contains("21 x 0.4"),
         "{err}"
+    );
+    bad.stiffness = MeshProfile::Constant { stiffness: 1e8 };
+    assert_eq!(bad.validate("gear stage `s2`"), Ok(()));
+}
+
+/// A true ratio (the marine line's 9.4094) with a constant mesh stiffness behind a first
+/// stage (`shaft_order = 1/9.4094`, no whole mesh order): accepted, and the static solution
+/// is the closed form. The pinion drives with `T` against a shaft `k_g` holding the gear:
+/// `k_g θ2 = i T`, `θ1 − i θ2 = T / k` (torsional stiffness on the pinion side).
+#[test]
+fn a_true_ratio_with_constant_stiffness_is_accepted() {
+    let (i, k, kg, t) = (9.4094, 5e6, 3e7, 40.0);
+    let mut stage = GearStage::new(
+        "a",
+        "b",
+        [1.0, 1.0],
+        17,
+        MeshProfile::Constant { stiffness: k },
+    )
+    .with_shaft_order(1.0 / 9.4094);
+    stage.base_radii = None;
+    stage.ratio = Some(i);
+    assert_eq!(stage.mesh_order(), None);
+    let soft = 1e-6;
+    let model = Model::builder(&["a", "b"])
+        .mass_diagonal(&[1e-2, 3.0])
+        .stiffness(DMatrix::from_diagonal(&hbal::nalgebra::DVector::from_vec(
+            vec![soft, kg],
+        )))
+        .gear_stage("reduction", stage)
+        .load("a", 0, t, 0.0)
+        .build()
+        .unwrap();
+    let sol = solve(&model, 50.0, 4);
+    let (th1, th2) = (sol.harmonic(0, 0).re, sol.harmonic(1, 0).re);
+    assert!((th2 - i * t / kg).abs() < 1e-8 * th2, "{th2}");
+    assert!(
+        ((th1 - i * th2) - t / k).abs() < 1e-8 * t / k,
+        "{th1} {th2}"
     );
 }
 
@@ -235,8 +272,8 @@ fn bad_gear_stages_name_the_element_and_field() {
             "unknown DOF `wheel`",
         ),
         (
-            "teeth = 2",
-            "teeth = 2\nshaft_order = 0.3",
+            "stiffness = { shape = \"constant\", stiffness = 3e8 }",
+            "stiffness = { shape = \"cosine\", mean = 3e8, amplitude = 3e7 }\nshaft_order = 0.3",
             "elements[0].shaft_order",
             "whole multiple",
         ),
@@ -272,7 +309,11 @@ fn bad_gear_stages_name_the_element_and_field() {
     let p = dir.join("bad.toml");
     std::fs::write(
         &p,
-        GOOD.replace("teeth = 2", "teeth = 2\nshaft_order = 0.3"),
+        GOOD.replace("teeth = 2", "teeth = 2\nshaft_order = 0.3")
+            .replace(
+                "shape = \"constant\", stiffness = 3e8",
+                "shape = \"cosine\", mean = 3e8, amplitude = 3e7",
+            ),
     )
     .unwrap();
     let out = common::hbal(&["check", p.to_str().unwrap()]);

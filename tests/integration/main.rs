@@ -30,6 +30,7 @@ mod condensation;
 mod condensation_branches;
 mod contact_quadrature;
 mod continuation;
+mod damped_to_ground;
 mod drivetrain;
 mod element_output;
 mod engine;

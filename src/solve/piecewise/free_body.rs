@@ -44,6 +44,12 @@ impl FreeBody {
             mean[load.dof] += load.cos;
         }
         rigid.check_balance(model, &mean)?;
+        if rigid.held() > 0 {
+            return Err(Error::InvalidElement {
+                context: "method `piecewise_exact`".into(),
+                reason: "a rigid-body motion of the model is held only by damping to ground, so the rigid motion does not separate from the flexible one; use harmonic balance (newton, anderson)".into(),
+            });
+        }
         // The elements' couplings w k wᵀ are symmetric; the structural matrices must leave
         // the modes free from the left as well (Rᵀ K = 0).
         let modes = rigid.modes();

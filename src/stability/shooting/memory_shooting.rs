@@ -206,7 +206,7 @@ fn check_cost(model: &Model, solution: &Solution) -> Result<()> {
 /// `true` if the shooting of laws with memory applies to `model` (up to [`MAX_DOFS`] DOFs, no rigid-body mode:
 /// their neutral multipliers 1 are not set apart from a sticking slider's).
 pub fn available(model: &Model) -> bool {
-    model.n_dofs() <= MAX_DOFS && rigid_body_modes(&Coordinates::full(model)).ncols() == 0
+    model.n_dofs() <= MAX_DOFS && rigid_body_modes(&Coordinates::full(model)).modes.ncols() == 0
 }
 
 /// `∂P/∂x` at `x` by forward differences from `P(x) = px`, or by central ones without it; and
