@@ -48,6 +48,9 @@ pub struct ModesAnalysis {
     pub max_hz: f64,
     /// How the operating point's solve ended.
     pub termination: Termination,
+    /// `true` where every law is linear in the state: the frequencies do not depend on an
+    /// operating point, and none was solved for.
+    pub linear: bool,
     /// The natural frequencies; `None` where the operating point did not converge.
     pub natural: Option<NaturalFrequencies>,
     /// The excitation orders of the reference speed.
@@ -121,12 +124,7 @@ pub fn modes(scene: &Scene, settings: &ModesSettings) -> Result<ModesAnalysis> {
         None if scene.model.n_dofs() <= 300 => f64::INFINITY,
         None => 5000.0,
     };
-    let hb = HarmonicBalance::with_formulation(&scene.model, scene.basis, settings.formulation)?;
-    let sol = scene.method.solve(&hb, None, &mut hb.workspace())?;
-    let natural = match sol.is_converged() {
-        true => Some(natural_frequencies(&scene.model, &sol, max_hz)?),
-        false => None,
-    };
+    let (termination, natural, linear) = operating_point(scene, settings, max_hz)?;
     let orders: Vec<f64> = excitation_orders(scene, &scene.basis)
         .into_iter()
         .map(|(o, _)| o)
@@ -142,13 +140,41 @@ pub fn modes(scene: &Scene, settings: &ModesSettings) -> Result<ModesAnalysis> {
         operating_speed: speed,
         range: (from, to),
         max_hz,
-        termination: sol.termination,
+        termination,
         natural,
+        linear,
         orders,
         critical,
         dofs: scene.model.dof_names().to_vec(),
         per_unit,
     })
+}
+
+/// How the operating point's solve ended, the natural frequencies linearised on it, and
+/// whether the model is linear in the state: then no solve (a free line held only by
+/// damping, or one whose statics the loads leave undetermined, still has its modes).
+fn operating_point(
+    scene: &Scene,
+    settings: &ModesSettings,
+    max_hz: f64,
+) -> Result<(Termination, Option<NaturalFrequencies>, bool)> {
+    let model = &scene.model;
+    if model
+        .elements()
+        .iter()
+        .all(|e| e.law().is_linear_in_state())
+    {
+        let rest = vec![0.0; model.n_dofs()];
+        let natural = crate::report::natural_frequencies_at(model, &rest, max_hz)?;
+        return Ok((Termination::Converged, Some(natural), true));
+    }
+    let hb = HarmonicBalance::with_formulation(model, scene.basis, settings.formulation)?;
+    let sol = scene.method.solve(&hb, None, &mut hb.workspace())?;
+    let natural = match sol.is_converged() {
+        true => Some(natural_frequencies(model, &sol, max_hz)?),
+        false => None,
+    };
+    Ok((sol.termination, natural, false))
 }
 
 /// Where the order lines meet the elastic modes' mean frequencies within `range`.
@@ -212,6 +238,7 @@ impl ModesAnalysis {
             "unit": self.unit,
             "operating_speed": self.operating_speed,
             "converged": true,
+            "linear": self.linear,
             "rigid_modes": nf.rigid,
             "modes": modes,
             "dofs": self.dofs,

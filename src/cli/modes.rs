@@ -72,13 +72,19 @@ fn table(a: &ModesAnalysis, nf: &NaturalFrequencies) {
     } else {
         "the highest".into()
     };
+    let at = if a.linear {
+        "a linear model (no operating point needed)".to_string()
+    } else {
+        format!(
+            "linearised on the orbit at {} {}",
+            a.operating_speed, a.unit
+        )
+    };
     say!(
-        "{}: {} modes up to {limit} ({} rigid), linearised on the orbit at {} {}",
+        "{}: {} modes up to {limit} ({} rigid), {at}",
         a.file,
         nf.mean.len(),
-        nf.rigid,
-        a.operating_speed,
-        a.unit
+        nf.rigid
     );
     say!("  mode   mean Hz    one-tooth Hz   two-tooth Hz   largest DOF");
     for (i, f) in nf.mean.iter().enumerate() {

@@ -13,7 +13,7 @@ pub use branch::{branch_csv, branch_csv_of_dofs, branch_csv_orders, branch_plot,
 pub use element_output::{element_outputs, ElementOutput, MeshOutput, Signal};
 pub use element_report::ElementReport;
 pub use html::{escape, HtmlReport};
-pub use modes::{natural_frequencies, NaturalFrequencies};
+pub use modes::{natural_frequencies, natural_frequencies_at, NaturalFrequencies};
 pub use plot::{line_plot, significant, tick_label, Axis, Series};
 pub use timing::median_time;
 pub use waterfall::{

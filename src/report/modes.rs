@@ -61,9 +61,29 @@ pub fn natural_frequencies(
     max_hz: f64,
 ) -> Result<NaturalFrequencies> {
     let n = model.n_dofs();
+    let mean: Vec<f64> = sol.harmonics()[..n].iter().map(|q| q.re).collect();
+    natural_frequencies_at(model, &mean, max_hz)
+}
+
+/// As [`natural_frequencies`], linearised at the mean coordinates `mean` (one per DOF)
+/// instead of a solution's: for a model whose laws are all linear in the state any `mean`
+/// gives the same frequencies, and no operating point is needed.
+pub fn natural_frequencies_at(
+    model: &Model,
+    mean: &[f64],
+    max_hz: f64,
+) -> Result<NaturalFrequencies> {
+    let n = model.n_dofs();
+    if mean.len() != n {
+        return Err(crate::Error::DimensionMismatch {
+            context: "natural frequencies".into(),
+            expected: format!("{n} mean coordinates"),
+            got: mean.len().to_string(),
+        });
+    }
     let mut ranges = Vec::with_capacity(model.elements().len());
     for e in model.elements() {
-        let mean_u = e.gather(&sol.harmonics()[..n]).re;
+        let mean_u = e.gather(mean);
         let (mut lo, mut hi, mut sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
         for j in 0..SAMPLES {
             let theta = TAU * j as f64 / SAMPLES as f64;

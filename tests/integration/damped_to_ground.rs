@@ -248,3 +248,55 @@ fn the_exact_method_refuses_a_motion_held_by_damping() {
         .solve_exact(&grounded, &basis)
         .is_ok());
 }
+
+/// `hbal modes` of a linear line needs no operating point: the modes of the damped line with
+/// an unbalanced mean torque (which `solve` refuses) are the generalised eigenvalues of
+/// `(K, M)`, one rigid.
+#[test]
+fn modes_of_a_linear_line_need_no_operating_point() {
+    let scene = "dofs = [\"a\", \"b\", \"c\"]\nmass = [[0.1, 0, 0], [0, 0.2, 0], [0, 0, 0.4]]\n\
+        stiffness = [[1e4, -1e4, 0], [-1e4, 3e4, -2e4], [0, -2e4, 2e4]]\n\
+        damping = [[2, -2, 0], [-2, 5, -3], [0, -3, 7]]\n\
+        fundamental = { rad_s = 120.0 }\nharmonics = { count = 3 }\n\
+        loads = [{ dof = \"a\", order = 0, cos = 50.0 }, { dof = \"a\", order = 1, cos = 5.0 }]\n";
+    let dir = std::env::temp_dir().join(format!("hbal-damped-modes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("line.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = common::hbal(&["modes", "--json", path.to_str().unwrap()]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["linear"], true);
+    assert_eq!(doc["rigid_modes"], 1);
+    let m_inv_half =
+        DMatrix::from_diagonal(&DVector::from_iterator(3, J.iter().map(|j| 1.0 / j.sqrt())));
+    let mut expected: Vec<f64> = (&m_inv_half * matrix(&K) * &m_inv_half)
+        .symmetric_eigenvalues()
+        .iter()
+        .map(|l| l.max(0.0).sqrt() / std::f64::consts::TAU)
+        .collect();
+    expected.sort_by(f64::total_cmp);
+    let got: Vec<f64> = doc["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["mean_hz"].as_f64().unwrap())
+        .collect();
+    assert_eq!(got.len(), 3, "{doc}");
+    assert!(got[0].abs() < 1e-6, "{got:?}");
+    for (g, e) in got.iter().zip(&expected).skip(1) {
+        assert!((g - e).abs() < 1e-10 * e, "{got:?} vs {expected:?}");
+    }
+    let text = common::hbal(&["modes", path.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        stdout.contains("a linear model (no operating point needed)"),
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
