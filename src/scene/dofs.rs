@@ -5,6 +5,8 @@
 //! dofs = ["x1", "x2"]                        # the names
 //! dofs = { file = "dofs.txt" }               # one per line; blank lines and `#` comments ignored
 //! dofs = { count = 1000, prefix = "shaft" }  # shaft.1 ... shaft.1000 (prefix default `dof`)
+//! dofs = { count = 4, first = 0 }            # dof.0 ... dof.3, numbered from 0 as
+//!                                            # openTorsion and most shaft-line tools do
 //! ```
 //!
 //! A sidecar file's path is relative to the scene file's directory.
@@ -53,6 +55,8 @@ struct DofSource {
     file: Option<String>,
     count: Option<usize>,
     prefix: Option<String>,
+    /// The number of the first generated name: 1 (default) or 0.
+    first: Option<u64>,
 }
 
 /// Reads the `dofs` field; errors are `(field path, message)`.
@@ -76,11 +80,13 @@ pub(super) fn read(value: &Value, base: &Path) -> Result<Dofs, (String, String)>
                     file: Some(file),
                     count: None,
                     prefix: None,
+                    first: None,
                 } => sidecar(&base.join(file)).map_err(|m| e("dofs.file", m))?,
                 DofSource {
                     file: None,
                     count: Some(count),
                     prefix,
+                    first,
                 } => {
                     if count > crate::Model::MAX_DOFS {
                         return Err(e(
@@ -95,8 +101,20 @@ pub(super) fn read(value: &Value, base: &Path) -> Result<Dofs, (String, String)>
                     if prefix.trim().is_empty() {
                         return Err(e("dofs.prefix", "must not be empty".into()));
                     }
+                    let first = match first {
+                        None => 1,
+                        Some(f @ (0 | 1)) => f as usize,
+                        Some(f) => {
+                            return Err(e(
+                                "dofs.first",
+                                format!("must be 0 or 1 (the number of the first name), got {f}"),
+                            ))
+                        }
+                    };
                     Dofs {
-                        names: (1..=count).map(|i| format!("{prefix}.{i}")).collect(),
+                        names: (first..first + count)
+                            .map(|i| format!("{prefix}.{i}"))
+                            .collect(),
                         origin: Some("dofs.count".into()),
                     }
                 }
@@ -107,6 +125,16 @@ pub(super) fn read(value: &Value, base: &Path) -> Result<Dofs, (String, String)>
                 } => {
                     return Err(e(
                         "dofs.prefix",
+                        "applies to `count` only, not to a `file`".into(),
+                    ))
+                }
+                DofSource {
+                    file: Some(_),
+                    first: Some(_),
+                    ..
+                } => {
+                    return Err(e(
+                        "dofs.first",
                         "applies to `count` only, not to a `file`".into(),
                     ))
                 }

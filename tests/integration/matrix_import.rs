@@ -212,6 +212,11 @@ fn generated_and_sidecar_dof_names() {
         names("{ count = 3 }", "a.toml"),
         ["dof.1", "dof.2", "dof.3"]
     );
+    // Numbered from 0, as openTorsion and most shaft-line tools number their nodes.
+    assert_eq!(
+        names("{ count = 3, prefix = \"node\", first = 0 }", "a.toml"),
+        ["node.0", "node.1", "node.2"]
+    );
     let scene = data_dir().join("scene.toml");
     assert_eq!(
         names("{ file = \"dofs.txt\" }", scene.to_str().unwrap()),

@@ -305,6 +305,18 @@ fn cases() -> Vec<Case> {
             vec![s("dofs.prefix: applies to `count` only")],
         ),
         (
+            "dofs_first_with_file",
+            bad_scene("{ file = \"dofs.txt\", first = 0 }", MASS, STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("dofs.first: applies to `count` only")],
+        ),
+        (
+            "dofs_first_two",
+            bad_scene("{ count = 3, first = 2 }", MASS, STIFFNESS),
+            with_k(GOOD_K),
+            vec![s("dofs.first: must be 0 or 1 (the number of the first name), got 2")],
+        ),
+        (
             "dofs_unknown_field",
             bad_scene("{ cuont = 3 }", MASS, STIFFNESS),
             with_k(GOOD_K),
