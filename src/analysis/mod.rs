@@ -59,7 +59,7 @@ pub use compare::{compare, CompareAnalysis, CompareAuto, CompareSettings, Method
 pub use element_record::order_of;
 pub use modes::{excitation_orders, modes, CriticalSpeed, ModesAnalysis, ModesSettings};
 pub use observer::{Observer, Silent};
-pub use options::{check, check_speed, check_sweep_start};
+pub use options::{check, check_speed, check_sweep_start, linear_frequencies};
 pub use output_choice::{reported_dofs, shown_output, Shown, ALL_DOFS_UP_TO};
 pub use parameter_sweep::{
     check_parameter_sweep, parameter_sweep, ParameterAuto, ParameterSweepAnalysis,

@@ -63,6 +63,23 @@ pub fn check(scene: &Scene) -> Result<()> {
     harmonic_balance(scene, scene.basis, crate::Formulation::Auto).map(|_| ())
 }
 
+/// The natural frequencies of `scene`'s model for `hbal check`, where every law is linear in
+/// the state (then they are the model's at every operating point; a nonlinear model's
+/// depend on its orbit: `hbal modes`); `None` otherwise, above 300 DOFs, or where the
+/// eigenproblem fails (a check does not fail on it).
+pub fn linear_frequencies(scene: &Scene) -> Option<crate::report::NaturalFrequencies> {
+    let model = &scene.model;
+    let linear = model
+        .elements()
+        .iter()
+        .all(|e| e.law().is_linear_in_state());
+    if !linear || model.n_dofs() > 300 {
+        return None;
+    }
+    let rest = vec![0.0; model.n_dofs()];
+    crate::report::natural_frequencies_at(model, &rest, f64::INFINITY).ok()
+}
+
 /// The harmonic balance a solve of `scene` at `basis` starts with.
 fn harmonic_balance(
     scene: &Scene,

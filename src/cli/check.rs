@@ -20,5 +20,28 @@ pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
         scene.basis.samples(),
         scene.method.name()
     );
+    if let Some(nf) = hbal::analysis::linear_frequencies(&scene) {
+        say!("  {}", frequencies(&nf));
+    }
     Ok(0)
+}
+
+/// `natural frequencies (Hz): 0 (1 rigid), 89.0983, ...`: the first 8 elastic ones.
+fn frequencies(nf: &hbal::report::NaturalFrequencies) -> String {
+    const SHOWN: usize = 8;
+    let elastic: Vec<String> = nf.mean[nf.rigid..]
+        .iter()
+        .take(SHOWN)
+        .map(|f| format!("{f:.6}"))
+        .collect();
+    let more = nf.mean.len().saturating_sub(nf.rigid + SHOWN);
+    let mut parts = Vec::new();
+    if nf.rigid > 0 {
+        parts.push(format!("0 ({} rigid)", nf.rigid));
+    }
+    parts.extend(elastic);
+    if more > 0 {
+        parts.push(format!("... ({more} more: hbal modes)"));
+    }
+    format!("natural frequencies (Hz): {}", parts.join(", "))
 }

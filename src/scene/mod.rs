@@ -34,6 +34,7 @@ pub mod export;
 mod fundamental;
 mod gear_stage;
 mod harmonics;
+mod line;
 mod loads;
 mod matrix;
 pub mod matrix_market;
@@ -159,7 +160,7 @@ impl Scene {
 
     /// Builds a scene from an already parsed document (see [`Scene::parse_value`],
     /// [`set_parameter`]).
-    pub fn from_value(value: Value, file: &str) -> Result<Scene, SceneError> {
+    pub fn from_value(mut value: Value, file: &str) -> Result<Scene, SceneError> {
         let err = |position, path: Option<String>, message: String| SceneError {
             file: file.to_string(),
             position,
@@ -169,6 +170,8 @@ impl Scene {
         // Types and field names first (an unknown field, a whole number given as 1e300, are
         // named as such), then the magnitude of every number before anything is built.
         let range = out_of_range(&value, String::new());
+        // The shaft-line vocabulary becomes the matrices it stands for.
+        line::expand(&mut value).map_err(|(path, message)| err(None, Some(path), message))?;
         let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
             let path = e.path().to_string();
             let message = whole_numbers_named(&e.into_inner().to_string());

@@ -64,6 +64,7 @@ mod reference_solutions;
 mod report;
 mod s_curve;
 mod scene_export;
+mod shaft_line;
 mod stability_at_scale;
 mod stability_exponential;
 mod stability_harmonic_orbit;

@@ -1,0 +1,219 @@
+//! The shaft-line vocabulary: `[line]` with disks and shafts, as shaft-line tools write a
+//! torsional model, expanded into the scene's `dofs`, `mass`, `stiffness` and `damping`
+//! (triplets) before anything else is read, so that every other table (loads, the engine,
+//! gear stages, every force law) names the disks as DOFs.
+//!
+//! ```toml
+//! [line]
+//! disks = [
+//!   { name = "engine", inertia = 0.15 },
+//!   { name = "propeller", inertia = 2.0, damping = 40.0 },  # damping to ground, N m s/rad
+//! ]
+//! shafts = [
+//!   { from = "engine", to = "propeller", stiffness = 5e4, damping = 5.0 },
+//!   # or from its geometry: k = G π (D⁴ − d⁴) / (32 L)
+//!   { from = "engine", to = "propeller", length = 1.2, outer_diameter = 0.08,
+//!     inner_diameter = 0.02, shear_modulus = 80e9 },
+//! ]
+//! ```
+//!
+//! A disk's `inertia` (kg m²) is its mass entry, its `damping` a damper to ground. A shaft
+//! (or a coupling: the same element) between disks `from` and `to` adds its torsional
+//! stiffness `k` and damping `c` to the four entries `(f, f), (t, t)` (+) and `(f, t), (t, f)`
+//! (−). The expansion is exact: the model equals the same matrices written by hand.
+
+use serde::Deserialize;
+use serde_json::{json, Map, Value};
+
+/// `[line]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Line {
+    disks: Vec<Disk>,
+    #[serde(default)]
+    shafts: Vec<Shaft>,
+}
+
+/// One disk: a DOF with its inertia and an optional damper to ground.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Disk {
+    name: String,
+    inertia: f64,
+    #[serde(default)]
+    damping: f64,
+}
+
+/// One shaft or coupling between two disks: its stiffness, or its geometry.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Shaft {
+    from: String,
+    to: String,
+    stiffness: Option<f64>,
+    #[serde(default)]
+    damping: f64,
+    length: Option<f64>,
+    outer_diameter: Option<f64>,
+    inner_diameter: Option<f64>,
+    shear_modulus: Option<f64>,
+}
+
+/// The fields `[line]` builds.
+const BUILT: [&str; 4] = ["dofs", "mass", "stiffness", "damping"];
+
+/// Replaces `line` in the document `doc` by `dofs`, `mass`, `stiffness` and `damping`;
+/// errors are `(field path, message)`. A document without `line` is left as it is.
+pub(super) fn expand(doc: &mut Value) -> Result<(), (String, String)> {
+    let Some(map) = doc.as_object_mut() else {
+        return Ok(());
+    };
+    let Some(value) = map.remove("line") else {
+        return Ok(());
+    };
+    if let Some(field) = BUILT.iter().find(|f| map.contains_key(**f)) {
+        return Err((
+            "line".into(),
+            format!("`line` builds `dofs`, `mass`, `stiffness` and `damping`, and the scene also gives `{field}`: give one or the other"),
+        ));
+    }
+    let line: Line = serde_path_to_error::deserialize(value).map_err(|x| {
+        let path = x.path().to_string();
+        let message = x.into_inner().to_string();
+        let path = super::field_path(path, &message);
+        let path = if path == "." {
+            "line".into()
+        } else {
+            format!("line.{path}")
+        };
+        (path, message)
+    })?;
+    let names = check_disks(&line.disks)?;
+    let index = |field: String, name: &str| -> Result<usize, (String, String)> {
+        names.iter().position(|n| n == name).ok_or_else(|| {
+            (
+                field,
+                format!("unknown disk `{name}` (the line has: {})", names.join(", ")),
+            )
+        })
+    };
+    let mut stiffness = Vec::new();
+    let mut damping: Vec<Value> = Vec::new();
+    for (i, disk) in line.disks.iter().enumerate() {
+        if disk.damping != 0.0 {
+            damping.push(json!([i + 1, i + 1, disk.damping]));
+        }
+    }
+    for (s, shaft) in line.shafts.iter().enumerate() {
+        let at = |field: &str| format!("line.shafts[{s}].{field}");
+        let (f, t) = (index(at("from"), &shaft.from)?, index(at("to"), &shaft.to)?);
+        if f == t {
+            return Err((
+                at("to"),
+                format!("the shaft ends where it starts, at `{}`", shaft.to),
+            ));
+        }
+        let k = shaft_stiffness(shaft, &at)?;
+        if !(shaft.damping.is_finite() && shaft.damping >= 0.0) {
+            return Err((
+                at("damping"),
+                format!("must be finite and >= 0, got {}", shaft.damping),
+            ));
+        }
+        couple(&mut stiffness, f, t, k);
+        if shaft.damping != 0.0 {
+            couple(&mut damping, f, t, shaft.damping);
+        }
+    }
+    let mass: Vec<Value> = line
+        .disks
+        .iter()
+        .enumerate()
+        .map(|(i, d)| json!([i + 1, i + 1, d.inertia]))
+        .collect();
+    map.insert("dofs".into(), json!(names));
+    map.insert("mass".into(), json!({ "triplets": mass }));
+    for (field, entries) in [("stiffness", stiffness), ("damping", damping)] {
+        if !entries.is_empty() {
+            map.insert(
+                field.into(),
+                Value::Object(Map::from_iter([("triplets".into(), Value::Array(entries))])),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The disks' names, checked: unique, with a positive inertia and a damping to ground >= 0.
+fn check_disks(disks: &[Disk]) -> Result<Vec<String>, (String, String)> {
+    if disks.is_empty() {
+        return Err(("line.disks".into(), "at least one disk is required".into()));
+    }
+    let mut names: Vec<String> = Vec::with_capacity(disks.len());
+    for (i, d) in disks.iter().enumerate() {
+        let at = |field: &str| format!("line.disks[{i}].{field}");
+        if d.name.trim().is_empty() || names.contains(&d.name) {
+            let why = if d.name.trim().is_empty() {
+                "must not be empty".to_string()
+            } else {
+                format!("`{}` names another disk already", d.name)
+            };
+            return Err((at("name"), why));
+        }
+        if !(d.inertia.is_finite() && d.inertia > 0.0) {
+            return Err((
+                at("inertia"),
+                format!("must be finite and > 0 (kg m²), got {}", d.inertia),
+            ));
+        }
+        if !(d.damping.is_finite() && d.damping >= 0.0) {
+            return Err((
+                at("damping"),
+                format!("must be finite and >= 0 (N m s/rad), got {}", d.damping),
+            ));
+        }
+        names.push(d.name.clone());
+    }
+    Ok(names)
+}
+
+/// The shaft's torsional stiffness: given, or `G π (D⁴ − d⁴) / (32 L)` from its geometry.
+fn shaft_stiffness(shaft: &Shaft, at: &dyn Fn(&str) -> String) -> Result<f64, (String, String)> {
+    let positive = |field: &str, v: f64| -> Result<f64, (String, String)> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err((at(field), format!("must be finite and > 0, got {v}")))
+        }
+    };
+    let geometry = [shaft.length, shaft.outer_diameter, shaft.shear_modulus];
+    match (shaft.stiffness, geometry) {
+        (Some(k), [None, None, None]) if shaft.inner_diameter.is_none() => positive("stiffness", k),
+        (None, [Some(l), Some(d_out), Some(g)]) => {
+            let (l, d_out, g) = (positive("length", l)?, positive("outer_diameter", d_out)?, positive("shear_modulus", g)?);
+            let d_in = shaft.inner_diameter.unwrap_or(0.0);
+            if !(d_in.is_finite() && d_in >= 0.0 && d_in < d_out) {
+                return Err((at("inner_diameter"), format!("must be >= 0 and below the outer diameter {d_out}, got {d_in}")));
+            }
+            // D⁴ as (D²)², the same bits wherever it is computed (`powi` may be folded).
+            let fourth = |d: f64| (d * d) * (d * d);
+            let polar = std::f64::consts::PI * (fourth(d_out) - fourth(d_in)) / 32.0;
+            Ok(g * polar / l)
+        }
+        _ => Err((
+            at("stiffness").trim_end_matches(".stiffness").to_string(),
+            "give `stiffness` (N m/rad), or `length`, `outer_diameter` and `shear_modulus` (with `inner_diameter` for a hollow shaft), not both".into(),
+        )),
+    }
+}
+
+/// Adds `c` between DOFs `f` and `t` (0-based) to 1-based triplets.
+fn couple(entries: &mut Vec<Value>, f: usize, t: usize, c: f64) {
+    let (f, t) = (f + 1, t + 1);
+    entries.extend([
+        json!([f, f, c]),
+        json!([t, t, c]),
+        json!([f, t, -c]),
+        json!([t, f, -c]),
+    ]);
+}
