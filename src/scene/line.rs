@@ -86,7 +86,7 @@ pub(super) fn expand(doc: &mut Value) -> Result<(), (String, String)> {
         } else {
             format!("line.{path}")
         };
-        (path, message)
+        (path.clone(), late_field_hint(&path, message))
     })?;
     let names = check_disks(&line.disks)?;
     let index = |field: String, name: &str| -> Result<usize, (String, String)> {
@@ -142,6 +142,25 @@ pub(super) fn expand(doc: &mut Value) -> Result<(), (String, String)> {
         }
     }
     Ok(())
+}
+
+/// Scene fields written after `[line]` in TOML belong to it: `message` with that said.
+fn late_field_hint(path: &str, message: String) -> String {
+    const SCENE_FIELDS: [&str; 7] = [
+        "fundamental",
+        "harmonics",
+        "loads",
+        "engine",
+        "elements",
+        "solver",
+        "description",
+    ];
+    let field = path.trim_start_matches("line.");
+    if SCENE_FIELDS.contains(&field) {
+        format!("{message} (a scene field: in TOML, fields after `[line]` belong to it; write `{field}` before the `[line]` table)")
+    } else {
+        message
+    }
 }
 
 /// The disks' names, checked: unique, with a positive inertia and a damping to ground >= 0.

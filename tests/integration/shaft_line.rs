@@ -177,6 +177,15 @@ fn bad_lines_name_the_table_and_field() {
         assert_eq!(err.path.as_deref(), Some(path), "{to}: {err}");
         assert!(err.to_string().contains(what), "{to}: {err}");
     }
+    // A scene field written after `[line]` belongs to it in TOML: the message says so.
+    let late = format!("{LINE}fundamental = {{ rpm = 1200 }}\n");
+    let err = Scene::from_str(&late, "late.toml").unwrap_err();
+    assert_eq!(err.path.as_deref(), Some("line.fundamental"), "{err}");
+    assert!(
+        err.to_string()
+            .contains("write `fundamental` before the `[line]` table"),
+        "{err}"
+    );
     // `line` and matrices together.
     let both = format!("{SPEED}dofs = [\"x\"]\n{LINE}");
     let err = Scene::from_str(&both, "both.toml").unwrap_err();
