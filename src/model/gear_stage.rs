@@ -242,7 +242,13 @@ impl GearStage {
     pub fn element(&self) -> ([(&str, f64); 2], Box<dyn ForceLaw>) {
         let [r1, r2] = self.lever_arms();
         let weights = [(self.driving.as_str(), r1), (self.driven.as_str(), -r2)];
-        let z = self.mesh_order().unwrap_or(1);
+        // A constant stiffness has no mesh order: one cycle per period, whatever the teeth.
+        let varies = self.stiffness.time_order(1).is_some();
+        let z = if varies {
+            self.mesh_order().unwrap_or(1)
+        } else {
+            1
+        };
         let law: Box<dyn ForceLaw> = match self.backlash {
             None => Box::new(
                 MeshStiffness::new(z, self.stiffness.clone(), self.damping).with_phase(self.phase),

@@ -39,7 +39,7 @@ use nalgebra::DMatrix;
 /// condensed formulation, to solve in the complement).
 pub const SHIFT: f64 = 1e-10;
 
-/// Largest relative net torque `|rᵀ f_0| / Σ_i |r_i f_0,i|` still taken for rounding.
+/// Largest relative net torque `|rᵀ f_0| / (max|r| Σ_i |f_0,i|)` still taken for rounding.
 pub const BALANCE_TOLERANCE: f64 = 1e-8;
 
 /// Largest relative restraint of `x` that still counts as rounding: `‖K x‖∞ / (max|K| ‖x‖∞)`
@@ -233,12 +233,9 @@ impl RigidModes {
                 .unwrap_or(0);
             let sign = r[reference].signum();
             let net: f64 = r.iter().zip(f0).map(|(ri, fi)| ri * fi).sum::<f64>() * sign / top;
-            let gross: f64 = r
-                .iter()
-                .zip(f0)
-                .map(|(ri, fi)| (ri * fi).abs())
-                .sum::<f64>()
-                / top;
+            // Against the whole mean load: a mode that carries none of it (another sub-chain's)
+            // has a net torque of rounding only, not comparable with its own products.
+            let gross: f64 = f0.iter().map(|fi| fi.abs()).sum();
             if net.abs() > BALANCE_TOLERANCE * gross {
                 let names = model.dof_names();
                 let loaded: Vec<String> = (0..f0.len())

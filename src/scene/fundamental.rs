@@ -110,7 +110,12 @@ fn stage_mesh_order(e: &Map<String, Value>) -> Option<f64> {
         .get("stiffness")
         .and_then(|s| s.get("shape"))
         .and_then(Value::as_str);
-    if shape == Some("constant") {
+    let flat = e
+        .get("stiffness")
+        .and_then(|s| s.get("amplitude"))
+        .and_then(Value::as_f64)
+        == Some(0.0);
+    if shape == Some("constant") || (shape == Some("cosine") && flat) {
         return None;
     }
     let teeth = e.get("teeth")?.as_f64()?;

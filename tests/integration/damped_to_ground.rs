@@ -300,3 +300,54 @@ fn modes_of_a_linear_line_need_no_operating_point() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Two separate lines, each held only by its own propeller damper, the mean torque on line a
+/// only: each line's balance is judged against the whole mean load, so line b (net torque
+/// rounding, ~1e-17) is not refused (it was, found by review), and stability counts two
+/// neutral multipliers.
+#[test]
+fn two_lines_each_held_by_a_damper_balance_separately() {
+    let model = Model::builder(&["a1", "a2", "b1", "b2"])
+        .mass_diagonal(&[1.0, 2.0, 1.0, 1.5])
+        .stiffness(DMatrix::from_row_slice(
+            4,
+            4,
+            &[
+                1.0, -1.0, 0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 2.0, -2.0, 0.0, 0.0, -2.0, 2.0,
+            ],
+        ))
+        .damping(DMatrix::from_row_slice(
+            4,
+            4,
+            &[
+                0.03, -0.03, 0.0, 0.0, -0.03, 0.23, 0.0, 0.0, 0.0, 0.0, 0.04, -0.04, 0.0, 0.0,
+                -0.04, 0.34,
+            ],
+        ))
+        .load("a1", 0, 0.05, 0.0)
+        .load("a2", 0, -0.05, 0.0)
+        .load("a1", 1, 0.1, 0.0)
+        .load("b1", 1, 0.2, 0.0)
+        .build()
+        .unwrap();
+    let hb = HarmonicBalance::new(&model, HarmonicBasis::new(1.0, 5).unwrap()).unwrap();
+    assert_eq!(hb.rigid_modes().map(|r| (r.len(), r.held())), Some((2, 2)));
+    let sol = newton(&hb);
+    // Line a's twist is the mean torque over its shaft.
+    let twist = sol.harmonic(0, 0).re - sol.harmonic(1, 0).re;
+    assert!((twist - 0.05).abs() < 1e-12, "{twist}");
+    let f = FloquetOptions::default().compute(&model, &sol).unwrap();
+    assert_eq!(f.neutral, 2);
+    // An unbalanced mean torque on line b is still refused.
+    let unbalanced = Model::builder(&["a1", "a2", "b1", "b2"])
+        .mass_diagonal(&[1.0, 2.0, 1.0, 1.5])
+        .stiffness(model.dense("test").unwrap().stiffness)
+        .damping(model.dense("test").unwrap().damping)
+        .load("a1", 0, 0.05, 0.0)
+        .load("a2", 0, -0.05, 0.0)
+        .load("b1", 0, 1e-3, 0.0)
+        .build()
+        .unwrap();
+    let err = HarmonicBalance::new(&unbalanced, HarmonicBasis::new(1.0, 5).unwrap()).unwrap_err();
+    assert!(matches!(err, Error::UnbalancedStaticLoad { .. }), "{err}");
+}

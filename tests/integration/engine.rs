@@ -323,3 +323,33 @@ stiffness = {{ shape = \"cosine\", mean = 1e8, amplitude = 1e7 }}
     );
     assert!(err.to_string().contains("fundamental's order 1"), "{err}");
 }
+
+/// A cosine mesh stiffness of zero amplitude is constant: it does not choose the fundamental
+/// (it chose order 0.1 from 23 teeth at shaft order 0.4, review finding), as `constant` does not.
+#[test]
+fn a_flat_cosine_stage_does_not_choose_the_fundamental() {
+    let text = format!(
+        "{SCENE}
+[[elements]]
+name = \"stage\"
+type = \"gear_stage\"
+driving = \"engine\"
+driven = \"flywheel\"
+base_radii = [0.02, 0.04]
+teeth = 23
+shaft_order = 0.4
+stiffness = {{ shape = \"cosine\", mean = 1e8, amplitude = 0.0 }}
+"
+    );
+    let flat = Scene::from_str(&text, "flat.toml").unwrap();
+    let constant = Scene::from_str(
+        &text.replace(
+            "shape = \"cosine\", mean = 1e8, amplitude = 0.0",
+            "shape = \"constant\", stiffness = 1e8",
+        ),
+        "constant.toml",
+    )
+    .unwrap();
+    assert_eq!(flat.fundamental_order, constant.fundamental_order);
+    assert_eq!(flat.fundamental_order, 0.5);
+}

@@ -181,6 +181,18 @@ fn shaft_order_sets_the_mesh_order() {
     );
     bad.stiffness = MeshProfile::Constant { stiffness: 1e8 };
     assert_eq!(bad.validate("gear stage `s2`"), Ok(()));
+    // A constant stiffness builds its law with one cycle per period, whatever the teeth: a
+    // whole mesh order above the resolvable 65536 (60000 x 3) is no error (review finding).
+    let mut many = bad.clone();
+    many.teeth = 60000;
+    many.shaft_order = 3.0;
+    assert_eq!(many.validate("gear stage `s3`"), Ok(()));
+    let model = Model::builder(&["a", "b"])
+        .mass_diagonal(&[1e-3, 6e-3])
+        .stiffness(DMatrix::from_diagonal_element(2, 2, 1e4))
+        .gear_stage("s3", many)
+        .build();
+    assert!(model.is_ok(), "{model:?}");
 }
 
 /// A true ratio (the marine line's 9.4094) with a constant mesh stiffness behind a first
