@@ -285,11 +285,30 @@ fn split_by_damping(
     let h = modes.transpose() * dr;
     let eig = ((&h + h.transpose()) * 0.5).symmetric_eigen();
     let (rotated, mass_rotated) = (&modes * &eig.eigenvectors, &mass_modes * &eig.eigenvectors);
+    let (order, free) = free_first(model, &rotated, |x| x.to_vec());
+    (
+        columns(&rotated, &order),
+        columns(&mass_rotated, &order),
+        free,
+    )
+}
+
+/// The column order of `modes` with the free ones first ([`is_free`] of each column lifted to
+/// the model's DOFs by `lift`), and how many are free.
+pub(crate) fn free_first(
+    model: &Model,
+    modes: &DMatrix<f64>,
+    lift: impl Fn(&[f64]) -> Vec<f64>,
+) -> (Vec<usize>, usize) {
     let (free, held): (Vec<usize>, Vec<usize>) =
-        (0..modes.ncols()).partition(|&c| is_free(model, rotated.column(c).as_slice()));
-    let order: Vec<usize> = free.iter().chain(&held).copied().collect();
-    let pick = |a: &DMatrix<f64>| DMatrix::from_fn(a.nrows(), order.len(), |i, c| a[(i, order[c])]);
-    (pick(&rotated), pick(&mass_rotated), free.len())
+        (0..modes.ncols()).partition(|&c| is_free(model, &lift(modes.column(c).as_slice())));
+    let count = free.len();
+    (free.into_iter().chain(held).collect(), count)
+}
+
+/// The columns `order` of `a`, in that order.
+pub(crate) fn columns(a: &DMatrix<f64>, order: &[usize]) -> DMatrix<f64> {
+    DMatrix::from_fn(a.nrows(), order.len(), |i, c| a[(i, order[c])])
 }
 
 /// `true` if `a x` is rounding against `a`'s largest entry and `x`'s (`scale`).

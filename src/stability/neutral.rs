@@ -11,7 +11,7 @@
 //! those of `Wᵀ Φ W`.
 
 use super::system::Coordinates;
-use crate::model::rigid::{is_free, is_static_free};
+use crate::model::rigid::{columns, free_first, is_static_free};
 use nalgebra::DMatrix;
 
 /// The rigid-body modes in some coordinates: orthonormal columns, the free ones first.
@@ -47,13 +47,10 @@ fn split_by_damping(sys: &Coordinates, s: DMatrix<f64>) -> NeutralModes {
     let h = s.transpose() * &sys.damping * &s;
     let eig = ((&h + h.transpose()) * 0.5).symmetric_eigen();
     let rotated = &s * &eig.eigenvectors;
-    let (free, held): (Vec<usize>, Vec<usize>) = (0..rotated.ncols())
-        .partition(|&c| is_free(sys.model, &sys.lift(rotated.column(c).as_slice())));
-    let order: Vec<usize> = free.iter().chain(&held).copied().collect();
-    let modes = DMatrix::from_fn(rotated.nrows(), order.len(), |i, c| rotated[(i, order[c])]);
+    let (order, free) = free_first(sys.model, &rotated, |p| sys.lift(p));
     NeutralModes {
-        modes,
-        free: free.len(),
+        modes: columns(&rotated, &order),
+        free,
     }
 }
 
@@ -183,6 +180,7 @@ pub(crate) fn state_bases(neutral: &NeutralModes) -> (DMatrix<f64>, DMatrix<f64>
 mod tests {
     use super::*;
     use crate::force::LinearSpring;
+    use crate::model::rigid::is_free;
     use crate::model::Model;
 
     /// A chain of 2000 stiff shaft elements (1e9 N m/rad) held by one soft ground spring

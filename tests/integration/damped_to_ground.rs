@@ -196,8 +196,7 @@ fn a_static_load_on_a_motion_held_by_damping_is_refused() {
         damping = [[2, -2, 0], [-2, 5, -3], [0, -3, 7]]\n\
         fundamental = { rad_s = 120.0 }\nharmonics = { count = 3 }\n\
         loads = [{ dof = \"a\", order = 0, cos = 50.0 }]\n";
-    let dir = std::env::temp_dir().join(format!("hbal-damped-ground-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::cli::temp_dir("damped-ground");
     let path = dir.join("unbalanced.toml");
     std::fs::write(&path, scene).unwrap();
     let out = common::hbal(&["solve", path.to_str().unwrap()]);
@@ -259,8 +258,7 @@ fn modes_of_a_linear_line_need_no_operating_point() {
         damping = [[2, -2, 0], [-2, 5, -3], [0, -3, 7]]\n\
         fundamental = { rad_s = 120.0 }\nharmonics = { count = 3 }\n\
         loads = [{ dof = \"a\", order = 0, cos = 50.0 }, { dof = \"a\", order = 1, cos = 5.0 }]\n";
-    let dir = std::env::temp_dir().join(format!("hbal-damped-modes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::cli::temp_dir("damped-modes");
     let path = dir.join("line.toml");
     std::fs::write(&path, scene).unwrap();
     let out = common::hbal(&["modes", "--json", path.to_str().unwrap()]);
@@ -270,7 +268,7 @@ fn modes_of_a_linear_line_need_no_operating_point() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let doc = common::cli::json_of(&out);
     assert_eq!(doc["linear"], true);
     assert_eq!(doc["rigid_modes"], 1);
     let m_inv_half =

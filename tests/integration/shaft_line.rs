@@ -65,8 +65,7 @@ fn the_line_builds_the_matrices_written_by_hand() {
 
 #[test]
 fn check_prints_the_natural_frequencies_of_the_line() {
-    let dir = std::env::temp_dir().join(format!("hbal-line-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::cli::temp_dir("line");
     let path = dir.join("line.toml");
     std::fs::write(&path, format!("{SPEED}{LINE}")).unwrap();
     let out = common::hbal(&["check", path.to_str().unwrap()]);
@@ -192,8 +191,7 @@ fn bad_lines_name_the_table_and_field() {
     assert_eq!(err.path.as_deref(), Some("line"), "{err}");
     assert!(err.to_string().contains("also gives `dofs`"), "{err}");
     // Exit code 2 from the CLI, before any work.
-    let dir = std::env::temp_dir().join(format!("hbal-line-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::cli::temp_dir("line-bad");
     let path = dir.join("bad.toml");
     std::fs::write(
         &path,
