@@ -208,7 +208,7 @@ fn resonances(model: &Model, from: f64, to: f64) -> Result<Vec<f64>> {
     let mut orders: Vec<usize> = model
         .loads()
         .iter()
-        .filter(|l| l.order > 0 && (l.cos != 0.0 || l.sin != 0.0))
+        .filter(|l| l.order > 0 && !l.is_zero())
         .map(|l| l.order)
         .collect();
     orders.sort_unstable();

@@ -1,6 +1,6 @@
 //! Validating builder for [`Model`].
 
-use super::{Element, GearStage, Load, Model, SparseMatrix};
+use super::{Element, GearStage, Load, Model, SparseMatrix, SpeedLaw};
 use crate::error::{Error, Result};
 use crate::force::ForceLaw;
 use nalgebra::DMatrix;
@@ -26,7 +26,7 @@ pub struct ModelBuilder {
     mass: Option<Input>,
     damping: Option<Input>,
     stiffness: Option<Input>,
-    loads: Vec<(String, usize, f64, f64)>,
+    loads: Vec<(String, usize, f64, f64, Option<SpeedLaw>)>,
     elements: Vec<PendingElement>,
     /// The first triplet outside the DOFs: matrix, row, column.
     bad_triplet: Option<(&'static str, usize, usize)>,
@@ -119,7 +119,35 @@ impl ModelBuilder {
     /// Adds `cos · cos(k Ω t) + sin · sin(k Ω t)` to the load on `dof` (k = 0: static, with
     /// `sin = 0`).
     pub fn load(mut self, dof: &str, order: usize, cos: f64, sin: f64) -> Self {
-        self.loads.push((dof.to_string(), order, cos, sin));
+        self.loads.push((dof.to_string(), order, cos, sin, None));
+        self
+    }
+
+    /// Adds a load harmonic that follows the speed Ω: `(cos + i sin) · T(Ω)` with `T` the
+    /// [`SpeedLaw`] (a power of the speed, or a table of amplitude and phase over speed, for
+    /// which `(cos, sin) = (1, 0)` takes the table as it is).
+    ///
+    /// ```
+    /// use hbal::model::SpeedLaw;
+    /// let model = hbal::Model::builder(&["propeller"])
+    ///     .mass_diagonal(&[2.0])
+    ///     .stiffness(nalgebra::DMatrix::from_element(1, 1, 100.0))
+    ///     .load_over_speed("propeller", 0, -50.0, 0.0, SpeedLaw::power(2.0, 1000.0))
+    ///     .build()
+    ///     .unwrap();
+    /// let at_2000_rpm = 2000.0 * std::f64::consts::TAU / 60.0;
+    /// assert!((model.loads()[0].at(at_2000_rpm).0 + 200.0).abs() < 1e-9);
+    /// ```
+    pub fn load_over_speed(
+        mut self,
+        dof: &str,
+        order: usize,
+        cos: f64,
+        sin: f64,
+        law: SpeedLaw,
+    ) -> Self {
+        self.loads
+            .push((dof.to_string(), order, cos, sin, Some(law)));
         self
     }
 
@@ -220,7 +248,7 @@ impl ModelBuilder {
         };
 
         let mut loads = Vec::with_capacity(self.loads.len());
-        for (dof, order, c, s) in &self.loads {
+        for (dof, order, c, s, law) in &self.loads {
             let ctx = format!("load on `{dof}` order {order}");
             let i = index(&ctx, dof)?;
             crate::error::check_finite(&ctx, "cos", *c)?;
@@ -233,11 +261,21 @@ impl ModelBuilder {
                     "0 on a static load (order 0, where sin(0 Ωt) = 0)",
                 ));
             }
+            if let Some(law) = law {
+                law.validate(&ctx)?;
+                if *order == 0 && law.phase.iter().any(|p| *p != 0.0) {
+                    return Err(Error::InvalidElement {
+                        context: ctx,
+                        reason: "`phase` must be 0 on a static load (order 0): give the static load's sign in `amplitude`".into(),
+                    });
+                }
+            }
             loads.push(Load {
                 dof: i,
                 order: *order,
                 cos: *c,
                 sin: *s,
+                speed: law.clone().map(std::sync::Arc::new),
             });
         }
 

@@ -18,20 +18,48 @@
 //! `θ = Ω t = f φ`, `A cos(o(φ - φ_c) + ψ) = A cos α cos kθ + A sin α sin kθ` with
 //! `α = o φ_c - ψ`, which is the load's `(cos, sin)` pair.
 
+use super::SpeedLaw;
 use crate::error::{check_finite, check_non_negative, Error, Result};
 use std::f64::consts::TAU;
 
-/// One engine order of a cylinder's torque: `A cos(o (φ - φ_c) + ψ)`.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+/// One engine order of a cylinder's torque: `A cos(o (φ - φ_c) + ψ)`, with `A`, `ψ`
+/// constant, scaled by a power of the speed, or taken from a table over speed
+/// ([`SpeedLaw`]: then `amplitude` and `phase` are not given, NaN and 0 here).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EngineOrder {
     /// The order `o` (> 0), in multiples of the crank speed: 0.5, 1, 1.5, ...
     pub order: f64,
-    /// Amplitude `A` per cylinder, N m (>= 0).
+    /// Amplitude `A` per cylinder, N m (>= 0; at the reference speed of a power law); NaN
+    /// where a table gives it.
+    #[serde(default = "not_given", skip_serializing_if = "f64_is_nan")]
     pub amplitude: f64,
     /// Phase `ψ`, rad (default 0).
     #[serde(default)]
     pub phase: f64,
+    /// How `A` and `ψ` follow the speed, if they do.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed: Option<SpeedLaw>,
+}
+
+impl EngineOrder {
+    /// The order `o` with the constant amplitude `A` and phase `ψ`.
+    pub fn new(order: f64, amplitude: f64, phase: f64) -> Self {
+        Self {
+            order,
+            amplitude,
+            phase,
+            speed: None,
+        }
+    }
+}
+
+fn not_given() -> f64 {
+    f64::NAN
+}
+
+fn f64_is_nan(a: &f64) -> bool {
+    a.is_nan()
 }
 
 /// Where the cylinders' torques act: all on one DOF, or one DOF per cylinder (crank throws).
@@ -57,8 +85,8 @@ pub enum Cylinders {
 ///     firing_angles: None,
 ///     mean_torque: 25.0,
 ///     orders: vec![
-///         EngineOrder { order: 0.5, amplitude: 30.0, phase: 0.0 },
-///         EngineOrder { order: 2.0, amplitude: 60.0, phase: 0.0 },
+///         EngineOrder::new(0.5, 30.0, 0.0),
+///         EngineOrder::new(2.0, 60.0, 0.0),
 ///     ],
 /// };
 /// assert_eq!(engine.fundamental_order(), Some(0.5));
@@ -94,6 +122,9 @@ pub struct EngineExcitation {
     #[serde(default)]
     pub orders: Vec<EngineOrder>,
 }
+
+/// One load of an engine: `(DOF, harmonic k, cos, sin, speed law)`.
+pub type EngineLoad = (String, usize, f64, f64, Option<SpeedLaw>);
 
 fn four() -> u32 {
     4
@@ -225,8 +256,30 @@ impl EngineExcitation {
                     "finite, > 0 and at most 1e6 (the mean is `mean_torque`)",
                 ));
             }
-            check_non_negative(context, &format!("orders[{i}].amplitude"), o.amplitude)?;
-            check_finite(context, &format!("orders[{i}].phase"), o.phase)?;
+            match &o.speed {
+                Some(law) if law.is_table() => {
+                    if !o.amplitude.is_nan() || o.phase != 0.0 {
+                        return Err(bad(
+                            &format!("orders[{i}].amplitude"),
+                            "and `phase` are given by the table `speed`: leave them out".into(),
+                        ));
+                    }
+                }
+                _ if o.amplitude.is_nan() => {
+                    return Err(bad(
+                        &format!("orders[{i}].amplitude"),
+                        "is missing (N m per cylinder; or give a table over speed in `speed`)"
+                            .into(),
+                    ));
+                }
+                _ => {
+                    check_non_negative(context, &format!("orders[{i}].amplitude"), o.amplitude)?;
+                    check_finite(context, &format!("orders[{i}].phase"), o.phase)?;
+                }
+            }
+            if let Some(law) = &o.speed {
+                law.validate(&format!("{context} orders[{i}].speed"))?;
+            }
         }
         if self.fundamental_order().is_none() {
             return Err(bad(
@@ -239,10 +292,11 @@ impl EngineExcitation {
         Ok(())
     }
 
-    /// The loads `(DOF, harmonic k, cos, sin)` under a fundamental of order `fundamental`
-    /// (module documentation); an order that is not a whole multiple of it is an error that
-    /// names the order and the fundamental that would hold it.
-    pub fn loads(&self, fundamental: f64) -> Result<Vec<(String, usize, f64, f64)>> {
+    /// The loads `(DOF, harmonic k, cos, sin, speed law)` under a fundamental of order
+    /// `fundamental` (module documentation; with a table over speed, `(cos, sin)` is the
+    /// cylinder's unit phasor `e^{i o φ_c}`); an order that is not a whole multiple of it is
+    /// an error that names the order and the fundamental that would hold it.
+    pub fn loads(&self, fundamental: f64) -> Result<Vec<EngineLoad>> {
         let dofs = self.cylinder_dofs();
         let angles = self.firing_angles();
         let mut out = Vec::with_capacity(dofs.len() * (self.orders.len() + 1));
@@ -264,16 +318,18 @@ impl EngineExcitation {
         }
         for (dof, &phi) in dofs.iter().zip(&angles) {
             if self.mean_torque != 0.0 {
-                out.push((dof.clone(), 0, self.mean_torque, 0.0));
+                out.push((dof.clone(), 0, self.mean_torque, 0.0, None));
             }
             for o in &self.orders {
                 let k = (o.order / fundamental).round() as usize;
                 let alpha = o.order * phi - o.phase;
+                let a = if o.amplitude.is_nan() { 1.0 } else { o.amplitude };
                 out.push((
                     dof.clone(),
                     k,
-                    o.amplitude * alpha.cos(),
-                    o.amplitude * alpha.sin(),
+                    a * alpha.cos(),
+                    a * alpha.sin(),
+                    o.speed.clone().map(|l| l.on_fundamental_order(fundamental)),
                 ));
             }
         }

@@ -14,6 +14,7 @@ pub mod gear_stage;
 mod load;
 pub mod rigid;
 mod sparse;
+pub mod speed_law;
 
 pub use builder::ModelBuilder;
 pub use element::Element;
@@ -22,6 +23,7 @@ pub use gear_stage::GearStage;
 pub use load::Load;
 pub use rigid::RigidModes;
 pub use sparse::SparseMatrix;
+pub use speed_law::{SpeedLaw, Speeds};
 
 use crate::error::{Error, Result};
 use nalgebra::DMatrix;
@@ -202,23 +204,67 @@ impl Model {
             .fold(self.max_load_order(), usize::max)
     }
 
-    /// The load `f(θ)` from `(cos θ, sin θ)`, added into `out` (length n): `cos kθ`, `sin kθ`
-    /// by the recurrence `e^{ikθ} = e^{iθ} e^{i(k-1)θ}` (no trigonometric call).
-    pub fn load_into_phasor(&self, cos: f64, sin: f64, out: &mut [f64]) {
+    /// The load `f(θ)` at speed Ω from `(cos θ, sin θ)`, added into `out` (length n):
+    /// `cos kθ`, `sin kθ` by the recurrence `e^{ikθ} = e^{iθ} e^{i(k-1)θ}` (no
+    /// trigonometric call).
+    pub fn load_into_phasor(&self, omega: f64, cos: f64, sin: f64, out: &mut [f64]) {
         for l in &self.loads {
             let (mut c, mut s) = (1.0, 0.0);
             for _ in 0..l.order {
                 (c, s) = (c * cos - s * sin, s * cos + c * sin);
             }
-            out[l.dof] += l.cos * c + l.sin * s;
+            let (a, b) = l.at(omega);
+            out[l.dof] += a * c + b * s;
         }
     }
 
-    /// The load `f(θ)` at angle `θ = Ω t`, added into `out` (length n).
-    pub fn load_into(&self, theta: f64, out: &mut [f64]) {
+    /// The load `f(θ)` at speed Ω and angle `θ = Ω t`, added into `out` (length n).
+    pub fn load_into(&self, omega: f64, theta: f64, out: &mut [f64]) {
         for l in &self.loads {
             let k = l.order as f64;
-            out[l.dof] += l.cos * (k * theta).cos() + l.sin * (k * theta).sin();
+            let (a, b) = l.at(omega);
+            out[l.dof] += a * (k * theta).cos() + b * (k * theta).sin();
         }
+    }
+
+    /// `true` if some load follows the speed ([`Load::speed`]).
+    pub fn has_speed_dependent_loads(&self) -> bool {
+        self.loads.iter().any(|l| l.speed.is_some())
+    }
+
+    /// An error naming the first load whose speed law is not defined over the speeds `lo`
+    /// to `hi` (rad/s): a table over speed is never extrapolated.
+    pub fn check_load_speeds(&self, lo: f64, hi: f64) -> Result<()> {
+        let (lo, hi) = (lo.min(hi), lo.max(hi));
+        for l in &self.loads {
+            let Some(law) = &l.speed else { continue };
+            if !law.covers(lo, hi) {
+                let (a, b) = law.range_rpm();
+                let rpm = 60.0 / std::f64::consts::TAU / law.fundamental_order;
+                let needs = if lo == hi {
+                    format!("{} rpm", short_rpm(lo * rpm))
+                } else {
+                    format!("{} to {} rpm", short_rpm(lo * rpm), short_rpm(hi * rpm))
+                };
+                return Err(Error::InvalidElement {
+                    context: format!("load on `{}` order {}", self.dofs[l.dof], l.order),
+                    reason: format!(
+                        "its table over speed covers {} to {} rpm, and the analysis needs {needs}: extend the table (it is never extrapolated)",
+                        short_rpm(a),
+                        short_rpm(b),
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A speed in rpm to 6 decimals, without trailing zeros.
+fn short_rpm(x: f64) -> String {
+    if x.is_finite() {
+        format!("{}", (x * 1e6).round() / 1e6)
+    } else {
+        "∞".into()
     }
 }

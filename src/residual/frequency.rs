@@ -74,6 +74,7 @@ impl HarmonicBalance<'_> {
                 scatter_add(&act.weights, b.uk[k], &mut ws.rhs[k * n..(k + 1) * n]);
             }
         }
+        self.subtract_load_derivative(&mut ws.rhs);
         layout.pack(&ws.rhs, out);
         Ok(())
     }
@@ -128,6 +129,7 @@ impl HarmonicBalance<'_> {
     /// Multiplies the alternating load (harmonics `k >= 1` of `F_ext`) by `factor`; the static
     /// load stays. For a homotopy in the load amplitude.
     pub fn scale_alternating_load(&mut self, factor: f64) {
+        self.load_factor *= factor;
         let n = self.n;
         for v in self.f_ext[n..]
             .iter_mut()
@@ -150,6 +152,7 @@ impl HarmonicBalance<'_> {
         let basis = self.basis.with_omega(omega)?;
         if self.condensed.is_some() {
             self.basis = basis;
+            self.refresh_speed_loads()?;
             self.condense()?;
             self.refit_tail();
             return Ok(());
@@ -164,6 +167,7 @@ impl HarmonicBalance<'_> {
             None => DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?,
         };
         self.basis = basis;
+        self.refresh_speed_loads()?;
         self.refit_tail();
         Ok(())
     }

@@ -37,6 +37,7 @@ mod limits;
 mod located;
 mod memory;
 mod real_form;
+mod speed_loads;
 mod tail;
 pub(crate) use tail::corrects as tail_corrects;
 mod workspace;
@@ -75,6 +76,8 @@ pub struct HarmonicBalance<'m> {
     trig: Vec<(f64, f64)>,
     /// The tail correction (see `tail`), where a law linear in the state jumps in time.
     tail: Option<Box<tail::TailCorrection>>,
+    /// The factor on the alternating load ([`HarmonicBalance::scale_alternating_load`]).
+    load_factor: f64,
 }
 
 impl<'m> HarmonicBalance<'m> {
@@ -103,6 +106,7 @@ impl<'m> HarmonicBalance<'m> {
             });
         }
         limits::check_size(model, &basis, formulation)?;
+        model.check_load_speeds(basis.omega(), basis.omega())?;
         let mut f_ext = vec![Complex64::default(); (h + 1) * n];
         let nu = basis.subharmonic();
         for l in model.loads() {
@@ -114,7 +118,8 @@ impl<'m> HarmonicBalance<'m> {
                     harmonics: h / nu,
                 });
             }
-            f_ext[l.order * nu * n + l.dof] += crate::harmonic::from_cos_sin(l.cos, l.sin);
+            let (c, s) = l.at(basis.omega());
+            f_ext[l.order * nu * n + l.dof] += crate::harmonic::from_cos_sin(c, s);
         }
         // H = 0 is a static analysis by choice; otherwise every time variation must fit.
         for e in model.elements().iter().filter(|_| h > 0) {
@@ -162,6 +167,7 @@ impl<'m> HarmonicBalance<'m> {
                 Vec::new()
             },
             tail: None,
+            load_factor: 1.0,
         };
         let mean_load: Vec<f64> = hb.f_ext[..n].iter().map(|v| v.re).collect();
         match formulation.resolve(model) {

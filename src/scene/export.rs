@@ -138,7 +138,7 @@ pub fn write_scene(model: &Model, settings: &SceneSettings, path: &Path) -> Resu
     let loads: Vec<Value> = model
         .loads()
         .iter()
-        .map(|l| json!({ "dof": names[l.dof], "order": l.order, "cos": l.cos, "sin": l.sin }))
+        .map(|l| load_value(l, &names[l.dof], settings.order))
         .collect();
     doc.insert("loads".into(), Value::Array(loads));
     let mut solver = Map::new();
@@ -226,5 +226,43 @@ fn drop_nulls(v: &mut Value) {
         }
         Value::Array(a) => a.iter_mut().for_each(drop_nulls),
         _ => {}
+    }
+}
+
+/// A load as the scene writes it: `cos`, `sin` and a power law; or a table over speed, its
+/// base phasor `b` folded in (`|b| A`, `ψ - arg b`).
+fn load_value(l: &crate::model::Load, dof: &str, order: f64) -> Value {
+    // The law's rpm are the reference shaft's of its own fundamental order; the scene's
+    // reference shaft turns at `Ω / order`.
+    let speed = l.speed.as_deref().map(|law| {
+        let mut law = law.clone();
+        let scale = law.fundamental_order / order;
+        match &mut law.rpm {
+            crate::model::Speeds::Reference(r) => *r *= scale,
+            crate::model::Speeds::Table(t) => t.iter_mut().for_each(|r| *r *= scale),
+        }
+        law.fundamental_order = order;
+        law
+    });
+    match speed.as_ref() {
+        None => json!({ "dof": dof, "order": l.order, "cos": l.cos, "sin": l.sin }),
+        Some(law) if !law.is_table() => {
+            json!({ "dof": dof, "order": l.order, "cos": l.cos, "sin": l.sin, "speed": law })
+        }
+        Some(law) => {
+            let base = num_complex::Complex64::new(l.cos, l.sin);
+            let mut law = law.clone();
+            let (size, angle) = (base.norm(), base.arg());
+            for a in &mut law.amplitude {
+                *a *= size;
+            }
+            if angle != 0.0 {
+                law.phase.resize(law.amplitude.len(), 0.0);
+                for p in &mut law.phase {
+                    *p -= angle;
+                }
+            }
+            json!({ "dof": dof, "order": l.order, "speed": law })
+        }
     }
 }

@@ -97,13 +97,14 @@ impl<'m> Coordinates<'m> {
 
     /// The load `Vᵀ f(θ)` from `(cos θ, sin θ)`, added into `out` (see
     /// [`Model::load_into_phasor`]).
-    pub(crate) fn load_into_phasor(&self, cos: f64, sin: f64, out: &mut [f64]) {
+    pub(crate) fn load_into_phasor(&self, omega: f64, cos: f64, sin: f64, out: &mut [f64]) {
         for (l, dir) in self.model.loads().iter().zip(&self.loads) {
             let (mut c, mut s) = (1.0, 0.0);
             for _ in 0..l.order {
                 (c, s) = (c * cos - s * sin, s * cos + c * sin);
             }
-            let f = l.cos * c + l.sin * s;
+            let (lc, ls) = l.at(omega);
+            let f = lc * c + ls * s;
             for &(i, w) in dir {
                 out[i] += f * w;
             }

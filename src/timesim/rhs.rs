@@ -87,7 +87,7 @@ impl ODE<f64, Vec<f64>> for Rhs<'_> {
         let states = self.states.borrow();
         let mut a = self.acc.borrow_mut();
         a.fill(0.0);
-        self.model.load_into(theta, a.as_mut_slice());
+        self.model.load_into(self.omega, theta, a.as_mut_slice());
         let a_slice = a.as_mut_slice();
         self.model.structural_damping().mul_add(-1.0, v, a_slice);
         self.model.structural_stiffness().mul_add(-1.0, q, a_slice);

@@ -25,7 +25,8 @@ pub(super) fn state_scale(model: &Model, omega: f64) -> Vec<f64> {
         });
         let mut f = DVector::from_element(n, Complex64::default());
         for l in model.loads().iter().filter(|l| l.order == k) {
-            f[l.dof] += crate::harmonic::from_cos_sin(l.cos, l.sin);
+            let (c, s) = l.at(omega);
+            f[l.dof] += crate::harmonic::from_cos_sin(c, s);
         }
         if let Some(x) = z.lu().solve(&f) {
             for i in 0..n {

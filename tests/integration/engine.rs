@@ -24,22 +24,18 @@ fn four_cylinder(cylinders: Cylinders, dof: Option<&str>) -> EngineExcitation {
             (2.0, 60.0, 0.1),
         ]
         .iter()
-        .map(|&(order, amplitude, phase)| EngineOrder {
-            order,
-            amplitude,
-            phase,
-        })
+        .map(|&(order, amplitude, phase)| EngineOrder::new(order, amplitude, phase))
         .collect(),
     }
 }
 
 /// The torque on `dof` at crank angle φ from the loads (harmonic k of a fundamental of order
 /// `f`: `cos · cos(k f φ) + sin · sin(k f φ)`).
-fn from_loads(loads: &[(String, usize, f64, f64)], dof: &str, f: f64, phi: f64) -> f64 {
+fn from_loads(loads: &[hbal::model::engine::EngineLoad], dof: &str, f: f64, phi: f64) -> f64 {
     loads
         .iter()
         .filter(|l| l.0 == dof)
-        .map(|&(_, k, c, s)| {
+        .map(|&(_, k, c, s, _)| {
             let a = k as f64 * f * phi;
             c * a.cos() + s * a.sin()
         })
@@ -130,11 +126,7 @@ fn two_stroke_firing_interval() {
         firing_angles: None,
         mean_torque: 0.0,
         orders: (1..=3)
-            .map(|o| EngineOrder {
-                order: o as f64,
-                amplitude: 10.0,
-                phase: 0.0,
-            })
+            .map(|o| EngineOrder::new(o as f64, 10.0, 0.0))
             .collect(),
     };
     assert_eq!(e.fundamental_order(), Some(1.0));

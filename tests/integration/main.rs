@@ -65,6 +65,7 @@ mod report;
 mod s_curve;
 mod scene_export;
 mod shaft_line;
+mod speed_loads;
 mod stability_at_scale;
 mod stability_exponential;
 mod stability_harmonic_orbit;

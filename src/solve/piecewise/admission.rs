@@ -11,11 +11,16 @@ use crate::model::Model;
 /// ([`ForceLaw::is_piecewise_constant`](crate::force::ForceLaw::is_piecewise_constant)), mean
 /// loads that balance on a model that floats free.
 pub(super) fn check(model: &Model) -> Result<()> {
-    checked(model).map(|_| ())
+    checked(model, None).map(|_| ())
 }
 
 /// [`check`], returning the dense matrices it builds and the rigid-body modes.
-pub(super) fn checked(model: &Model) -> Result<(crate::model::DenseMatrices, Option<FreeBody>)> {
+/// The static balance of a model that floats free is checked at the speed `omega` (without
+/// it, where a static load follows the speed, at the solve).
+pub(super) fn checked(
+    model: &Model,
+    omega: Option<f64>,
+) -> Result<(crate::model::DenseMatrices, Option<FreeBody>)> {
     let n = model.n_dofs();
     if n > PiecewiseExact::MAX_DOFS {
         return Err(Error::TooLarge {
@@ -48,6 +53,6 @@ pub(super) fn checked(model: &Model) -> Result<(crate::model::DenseMatrices, Opt
             reason: "singular (the exact piecewise solution needs M⁻¹)".into(),
         });
     }
-    let free_body = FreeBody::find(model, &dense)?;
+    let free_body = FreeBody::find(model, &dense, omega)?;
     Ok((dense, free_body))
 }

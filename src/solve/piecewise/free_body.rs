@@ -35,15 +35,25 @@ pub(super) struct FreeBody {
 impl FreeBody {
     /// The rigid-body modes of `model`, or `None` if it is grounded. An error if the mean
     /// loads do not balance (the model would accelerate away).
-    pub(super) fn find(model: &Model, dense: &DenseMatrices) -> Result<Option<Self>> {
+    /// The balance is checked at the speed `omega`; without it, where a static load follows
+    /// the speed, not here.
+    pub(super) fn find(
+        model: &Model,
+        dense: &DenseMatrices,
+        omega: Option<f64>,
+    ) -> Result<Option<Self>> {
         let Some(rigid) = crate::model::rigid::find_dense(model, dense) else {
             return Ok(None);
         };
         let mut mean = vec![0.0; model.n_dofs()];
-        for load in model.loads().iter().filter(|l| l.order == 0) {
-            mean[load.dof] += load.cos;
+        let statics = model.loads().iter().filter(|l| l.order == 0);
+        let follows = statics.clone().any(|l| l.speed.is_some());
+        for load in statics {
+            mean[load.dof] += load.at(omega.unwrap_or(0.0)).0;
         }
-        rigid.check_balance(model, &mean)?;
+        if omega.is_some() || !follows {
+            rigid.check_balance(model, &mean)?;
+        }
         if rigid.held() > 0 {
             return Err(Error::InvalidElement {
                 context: "method `piecewise_exact`".into(),

@@ -69,7 +69,7 @@ impl Schedule {
     /// at every element's time breakpoint and builds each distinct configuration.
     pub(super) fn new(model: &Model, omega: f64) -> Result<Self> {
         let n = model.n_dofs();
-        let (dense, free_body) = checked(model)?;
+        let (dense, free_body) = checked(model, Some(omega))?;
         let mut breaks: Vec<f64> = model
             .elements()
             .iter()
@@ -198,8 +198,9 @@ impl Schedule {
         for order in 0..=orders {
             let block = &mut steady[order * n..(order + 1) * n];
             for load in model.loads().iter().filter(|l| l.order == order) {
-                let sin = if order == 0 { 0.0 } else { load.sin };
-                block[load.dof] += Complex64::new(load.cos, -sin);
+                let (cos, sin) = load.at(self.omega);
+                let sin = if order == 0 { 0.0 } else { sin };
+                block[load.dof] += Complex64::new(cos, -sin);
             }
             if order == 0 {
                 for (e, &(_, _, f)) in model.elements().iter().zip(coefficients) {

@@ -58,12 +58,13 @@ impl Forcing {
                 col[i] += w;
             }
             dirs.set_column(d, &(m_inv * col / scale_v));
+            let (lc, ls) = l.at(omega);
             match orders.iter().position(|&o| o == l.order) {
                 Some(i) if i > 0 => {
-                    c[(d, 2 * i - 1)] += l.cos;
-                    c[(d, 2 * i)] += l.sin;
+                    c[(d, 2 * i - 1)] += lc;
+                    c[(d, 2 * i)] += ls;
                 }
-                _ => c[(d, 0)] += l.cos,
+                _ => c[(d, 0)] += lc,
             }
         }
         let mut generator = DMatrix::zeros(states, states);

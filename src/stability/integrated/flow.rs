@@ -156,7 +156,7 @@ impl<'c, 'm> Flow<'c, 'm> {
         dq.copy_from_slice(v);
         self.load.fill(0.0);
         let (c, s) = self.phasor(t);
-        self.sys.load_into_phasor(c, s, &mut self.load);
+        self.sys.load_into_phasor(self.omega, c, s, &mut self.load);
         self.bc.copy_from_slice(&self.base);
         // q̈ = M⁻¹ f - (M⁻¹D) q̇ - (M⁻¹K) q, column by column of the column-major base.
         dv.fill(0.0);
