@@ -32,6 +32,12 @@ struct Line {
     disks: Vec<Disk>,
     #[serde(default)]
     shafts: Vec<Shaft>,
+    /// Rigid gear pairs, each removing one angle (see `line_gears.rs`).
+    #[serde(default)]
+    gears: Vec<super::line_gears::RigidGear>,
+    /// Damping ratios of the undamped modes (see `line_modal.rs`).
+    #[serde(default)]
+    modal_damping: Option<super::line_modal::ModalDamping>,
 }
 
 /// One disk: a DOF with its inertia and an optional damper to ground.
@@ -97,40 +103,71 @@ pub(super) fn expand(doc: &mut Value) -> Result<(), (String, String)> {
             )
         })
     };
+    let joins = super::line_gears::join(&names, &line.gears)?;
+    // The kept disks' new indices; every disk's (new index, factor).
+    let kept: Vec<usize> = (0..names.len()).filter(|&i| joins[i].0 == i).collect();
+    let at: Vec<(usize, f64)> = joins
+        .iter()
+        .map(|&(root, f)| (kept.iter().position(|&k| k == root).unwrap_or(0), f))
+        .collect();
     let mut stiffness = Vec::new();
     let mut damping: Vec<Value> = Vec::new();
+    let mut inertia = vec![0.0; kept.len()];
     for (i, disk) in line.disks.iter().enumerate() {
+        let (r, f) = at[i];
+        inertia[r] += disk.inertia * f * f;
         if disk.damping != 0.0 {
-            damping.push(json!([i + 1, i + 1, disk.damping]));
+            damping.push(json!([r + 1, r + 1, disk.damping * f * f]));
         }
     }
     for (s, shaft) in line.shafts.iter().enumerate() {
-        let at = |field: &str| format!("line.shafts[{s}].{field}");
-        let (f, t) = (index(at("from"), &shaft.from)?, index(at("to"), &shaft.to)?);
+        let at_field = |field: &str| format!("line.shafts[{s}].{field}");
+        let (f, t) = (
+            index(at_field("from"), &shaft.from)?,
+            index(at_field("to"), &shaft.to)?,
+        );
         if f == t {
             return Err((
-                at("to"),
+                at_field("to"),
                 format!("the shaft ends where it starts, at `{}`", shaft.to),
             ));
         }
-        let k = shaft_stiffness(shaft, &at)?;
+        let k = shaft_stiffness(shaft, &at_field)?;
         if !(shaft.damping.is_finite() && shaft.damping >= 0.0) {
             return Err((
-                at("damping"),
+                at_field("damping"),
                 format!("must be finite and >= 0, got {}", shaft.damping),
             ));
         }
-        couple(&mut stiffness, f, t, k);
+        couple(&mut stiffness, at[f], at[t], k);
         if shaft.damping != 0.0 {
-            couple(&mut damping, f, t, shaft.damping);
+            couple(&mut damping, at[f], at[t], shaft.damping);
         }
     }
-    let mass: Vec<Value> = line
-        .disks
+    if let Some(r) = inertia.iter().position(|j| *j <= 0.0) {
+        return Err((
+            format!("line.disks[{}].inertia", kept[r]),
+            format!("`{}` has no inertia, and no disk joined to it by a rigid gear has any: every angle of the line needs an inertia (M is singular)", names[kept[r]]),
+        ));
+    }
+    let mass: Vec<Value> = inertia
         .iter()
         .enumerate()
-        .map(|(i, d)| json!([i + 1, i + 1, d.inertia]))
+        .map(|(r, j)| json!([r + 1, r + 1, j]))
         .collect();
+    let names: Vec<&String> = kept.iter().map(|&k| &names[k]).collect();
+    if let Some(ratios) = &line.modal_damping {
+        let n = kept.len();
+        let mass = nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_vec(inertia.clone()));
+        let modal = super::line_modal::damping(ratios, &mass, &dense(&stiffness, n))?;
+        for i in 0..n {
+            for j in 0..n {
+                if modal[(i, j)] != 0.0 {
+                    damping.push(json!([i + 1, j + 1, modal[(i, j)]]));
+                }
+            }
+        }
+    }
     map.insert("dofs".into(), json!(names));
     map.insert("mass".into(), json!({ "triplets": mass }));
     for (field, entries) in [("stiffness", stiffness), ("damping", damping)] {
@@ -179,10 +216,10 @@ fn check_disks(disks: &[Disk]) -> Result<Vec<String>, (String, String)> {
             };
             return Err((at("name"), why));
         }
-        if !(d.inertia.is_finite() && d.inertia > 0.0) {
+        if !(d.inertia.is_finite() && d.inertia >= 0.0) {
             return Err((
                 at("inertia"),
-                format!("must be finite and > 0 (kg m²), got {}", d.inertia),
+                format!("must be finite and >= 0 (kg m²), got {}", d.inertia),
             ));
         }
         if !(d.damping.is_finite() && d.damping >= 0.0) {
@@ -226,13 +263,27 @@ fn shaft_stiffness(shaft: &Shaft, at: &dyn Fn(&str) -> String) -> Result<f64, (S
     }
 }
 
-/// Adds `c` between DOFs `f` and `t` (0-based) to 1-based triplets.
-fn couple(entries: &mut Vec<Value>, f: usize, t: usize, c: f64) {
-    let (f, t) = (f + 1, t + 1);
+/// Adds `c` on `u = f_a θ_a − f_b θ_b` to 1-based triplets, with `(a, f_a)`, `(b, f_b)` the
+/// two ends' DOFs (0-based) and factors: `c f_a²`, `c f_b²` and `−c f_a f_b` (exactly `c` and
+/// `−c` where both factors are 1).
+fn couple(entries: &mut Vec<Value>, (a, fa): (usize, f64), (b, fb): (usize, f64), c: f64) {
+    let (a, b) = (a + 1, b + 1);
+    let cross = -c * fa * fb;
     entries.extend([
-        json!([f, f, c]),
-        json!([t, t, c]),
-        json!([f, t, -c]),
-        json!([t, f, -c]),
+        json!([a, a, c * fa * fa]),
+        json!([b, b, c * fb * fb]),
+        json!([a, b, cross]),
+        json!([b, a, cross]),
     ]);
+}
+
+/// The dense n × n matrix of 1-based triplets `[row, column, value]` (repeats add up).
+fn dense(entries: &[Value], n: usize) -> nalgebra::DMatrix<f64> {
+    let mut a = nalgebra::DMatrix::zeros(n, n);
+    for e in entries {
+        if let (Some(i), Some(j), Some(v)) = (e[0].as_u64(), e[1].as_u64(), e[2].as_f64()) {
+            a[(i as usize - 1, j as usize - 1)] += v;
+        }
+    }
+    a
 }

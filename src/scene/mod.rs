@@ -35,6 +35,8 @@ mod fundamental;
 mod gear_stage;
 mod harmonics;
 mod line;
+mod line_gears;
+mod line_modal;
 mod loads;
 mod matrix;
 pub mod matrix_market;

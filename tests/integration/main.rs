@@ -60,6 +60,7 @@ mod options_contract;
 mod order_cuts;
 mod piecewise_exact;
 mod piecewise_exact_cli;
+mod published_lines;
 mod reference_solutions;
 mod report;
 mod s_curve;
