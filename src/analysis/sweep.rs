@@ -194,7 +194,9 @@ fn plan(scene: &Scene, settings: &SweepSettings) -> Result<Plan> {
         .unwrap_or_else(|| start_omega.unwrap_or(scene.basis.omega()) / per);
     super::check_speed(scene, "--from", from, false)?;
     super::check_speed(scene, "--to", settings.to, false)?;
-    scene.model.check_load_speeds(from * per, settings.to * per)?;
+    scene
+        .model
+        .check_load_speeds(from * per, settings.to * per)?;
     if let Some(s) = &settings.start {
         if scene.auto.is_some() {
             return Err(Error::InvalidOptions {

@@ -323,7 +323,11 @@ impl EngineExcitation {
             for o in &self.orders {
                 let k = (o.order / fundamental).round() as usize;
                 let alpha = o.order * phi - o.phase;
-                let a = if o.amplitude.is_nan() { 1.0 } else { o.amplitude };
+                let a = if o.amplitude.is_nan() {
+                    1.0
+                } else {
+                    o.amplitude
+                };
                 out.push((
                     dof.clone(),
                     k,

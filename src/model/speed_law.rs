@@ -118,7 +118,10 @@ impl SpeedLaw {
         match (&self.exponent, &self.rpm) {
             (Some(n), Speeds::Reference(r)) => {
                 if !n.is_finite() || n.abs() > 16.0 {
-                    return Err(bad("exponent", format!("must be finite and within ±16, got {n}")));
+                    return Err(bad(
+                        "exponent",
+                        format!("must be finite and within ±16, got {n}"),
+                    ));
                 }
                 if !(r.is_finite() && *r > 0.0) {
                     return Err(bad("rpm", format!("must be finite and > 0, got {r}")));
@@ -140,7 +143,10 @@ impl SpeedLaw {
 
     fn validate_table(&self, rpm: &[f64], bad: &dyn Fn(&str, String) -> Error) -> Result<()> {
         if rpm.len() < 2 {
-            return Err(bad("rpm", format!("needs at least two speeds, got {}", rpm.len())));
+            return Err(bad(
+                "rpm",
+                format!("needs at least two speeds, got {}", rpm.len()),
+            ));
         }
         for (i, w) in rpm.windows(2).enumerate() {
             if !(w[0].is_finite() && w[1].is_finite() && w[0] >= 0.0 && w[1] > w[0]) {
@@ -155,9 +161,19 @@ impl SpeedLaw {
                 ));
             }
         }
-        for (name, values, optional) in [("amplitude", &self.amplitude, false), ("phase", &self.phase, true)] {
+        for (name, values, optional) in [
+            ("amplitude", &self.amplitude, false),
+            ("phase", &self.phase, true),
+        ] {
             if values.len() != rpm.len() && !(optional && values.is_empty()) {
-                return Err(bad(name, format!("must have one value per speed ({}), got {}", rpm.len(), values.len())));
+                return Err(bad(
+                    name,
+                    format!(
+                        "must have one value per speed ({}), got {}",
+                        rpm.len(),
+                        values.len()
+                    ),
+                ));
             }
             if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
                 return Err(bad(name, format!("must be finite, got {name}[{i}] = {v}")));
@@ -221,7 +237,10 @@ impl SpeedLaw {
             return (polar(amplitude(i), phase(i)), Complex64::default());
         }
         // The segment [rpm[i], rpm[i+1]) holding n.
-        let i = rpm.partition_point(|&r| r <= n).saturating_sub(1).min(last - 1);
+        let i = rpm
+            .partition_point(|&r| r <= n)
+            .saturating_sub(1)
+            .min(last - 1);
         let width = rpm[i + 1] - rpm[i];
         let s = (n - rpm[i]) / width;
         let a = amplitude(i) + s * (amplitude(i + 1) - amplitude(i));

@@ -68,14 +68,19 @@ struct Shaft {
 /// The fields `[line]` builds.
 const BUILT: [&str; 4] = ["dofs", "mass", "stiffness", "damping"];
 
-/// Replaces `line` in the document `doc` by `dofs`, `mass`, `stiffness` and `damping`;
-/// errors are `(field path, message)`. A document without `line` is left as it is.
-pub(super) fn expand(doc: &mut Value) -> Result<(), (String, String)> {
+/// A disk a rigid gear removed: its name, the kept disk's and the factor, `θ = f θ_kept`.
+pub(super) type Removed = (String, String, f64);
+
+/// Replaces `line` in the document `doc` by `dofs`, `mass`, `stiffness` and `damping`, and
+/// moves each load on a disk a rigid gear removed onto the disk it follows (times the factor
+/// `f`: the same virtual work); returns the removed disks. Errors are `(field path,
+/// message)`. A document without `line` is left as it is.
+pub(super) fn expand(doc: &mut Value) -> Result<Vec<Removed>, (String, String)> {
     let Some(map) = doc.as_object_mut() else {
-        return Ok(());
+        return Ok(Vec::new());
     };
     let Some(value) = map.remove("line") else {
-        return Ok(());
+        return Ok(Vec::new());
     };
     if let Some(field) = BUILT.iter().find(|f| map.contains_key(**f)) {
         return Err((
@@ -155,6 +160,10 @@ pub(super) fn expand(doc: &mut Value) -> Result<(), (String, String)> {
         .enumerate()
         .map(|(r, j)| json!([r + 1, r + 1, j]))
         .collect();
+    let removed: Vec<Removed> = (0..names.len())
+        .filter(|&i| joins[i].0 != i)
+        .map(|i| (names[i].clone(), names[joins[i].0].clone(), joins[i].1))
+        .collect();
     let names: Vec<&String> = kept.iter().map(|&k| &names[k]).collect();
     if let Some(ratios) = &line.modal_damping {
         let n = kept.len();
@@ -178,7 +187,38 @@ pub(super) fn expand(doc: &mut Value) -> Result<(), (String, String)> {
             );
         }
     }
-    Ok(())
+    move_loads(map, &removed);
+    Ok(removed)
+}
+
+/// Each load on a removed disk moved onto the disk it follows, its amplitudes (`cos`, `sin`
+/// or a speed table's `amplitude`) times the factor.
+fn move_loads(map: &mut Map<String, Value>, removed: &[Removed]) {
+    let Some(Value::Array(loads)) = map.get_mut("loads") else {
+        return;
+    };
+    for load in loads.iter_mut().filter_map(|l| l.as_object_mut()) {
+        let Some((_, kept, f)) = removed
+            .iter()
+            .find(|r| load.get("dof").and_then(Value::as_str) == Some(r.0.as_str()))
+        else {
+            continue;
+        };
+        load.insert("dof".into(), json!(kept));
+        let scale = |v: &mut Value| {
+            if let Some(x) = v.as_f64() {
+                *v = json!(x * f);
+            }
+        };
+        for field in ["cos", "sin"] {
+            if let Some(v) = load.get_mut(field) {
+                scale(v);
+            }
+        }
+        if let Some(Value::Array(a)) = load.get_mut("speed").and_then(|s| s.get_mut("amplitude")) {
+            a.iter_mut().for_each(scale);
+        }
+    }
 }
 
 /// Scene fields written after `[line]` in TOML belong to it: `message` with that said.

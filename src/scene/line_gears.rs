@@ -43,9 +43,15 @@ pub(super) fn join(names: &[String], gears: &[RigidGear]) -> Result<Joins, (Stri
                 )
             })
         };
-        let (a, b) = (index("driving", &gear.driving)?, index("driven", &gear.driven)?);
+        let (a, b) = (
+            index("driving", &gear.driving)?,
+            index("driven", &gear.driven)?,
+        );
         if a == b {
-            return Err((at("driven"), format!("the gear meshes `{}` with itself", gear.driven)));
+            return Err((
+                at("driven"),
+                format!("the gear meshes `{}` with itself", gear.driven),
+            ));
         }
         let ratio = ratio_of(gear, &at)?;
         // θ_b = θ_a / i with θ_a = fa θ_ra, θ_b = fb θ_rb.

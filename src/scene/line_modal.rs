@@ -36,7 +36,11 @@ pub(super) fn damping(
         ModalDamping::All(z) => vec![*z],
         ModalDamping::PerMode(z) => z.clone(),
     };
-    if let Some((i, z)) = list.iter().enumerate().find(|(_, z)| !(z.is_finite() && **z >= 0.0)) {
+    if let Some((i, z)) = list
+        .iter()
+        .enumerate()
+        .find(|(_, z)| !(z.is_finite() && **z >= 0.0))
+    {
         let at = match ratios {
             ModalDamping::All(_) => field.to_string(),
             ModalDamping::PerMode(_) => format!("{field}[{i}]"),
@@ -46,7 +50,12 @@ pub(super) fn damping(
     let l = mass
         .clone()
         .cholesky()
-        .ok_or_else(|| (field.to_string(), "needs a positive definite mass matrix".to_string()))?
+        .ok_or_else(|| {
+            (
+                field.to_string(),
+                "needs a positive definite mass matrix".to_string(),
+            )
+        })?
         .l();
     let l_inv = l
         .clone()

@@ -40,7 +40,9 @@ pub(super) fn engine_error(e: crate::Error) -> (String, String) {
                 .strip_prefix('`')
                 .and_then(|m| m.split('`').next())
                 .filter(|f| !f.contains(' '));
-            let within = context.strip_prefix("engine ").filter(|c| c.starts_with("orders["));
+            let within = context
+                .strip_prefix("engine ")
+                .filter(|c| c.starts_with("orders["));
             let path = match (within, field) {
                 (Some(w), Some(f)) => format!("engine.{w}.{f}"),
                 (Some(w), None) => format!("engine.{w}"),

@@ -173,7 +173,8 @@ impl Scene {
         // named as such), then the magnitude of every number before anything is built.
         let range = out_of_range(&value, String::new());
         // The shaft-line vocabulary becomes the matrices it stands for.
-        line::expand(&mut value).map_err(|(path, message)| err(None, Some(path), message))?;
+        let removed =
+            line::expand(&mut value).map_err(|(path, message)| err(None, Some(path), message))?;
         let parsed: SceneFile = serde_path_to_error::deserialize(value).map_err(|e| {
             let path = e.path().to_string();
             let message = whole_numbers_named(&e.into_inner().to_string());
@@ -191,7 +192,18 @@ impl Scene {
                 ),
             ));
         }
-        parsed.build(file)
+        parsed.build(file).map_err(|mut e| {
+            // A disk a rigid gear removed, named where only loads may name it.
+            if let Some((gone, kept, f)) = removed
+                .iter()
+                .find(|r| e.message.contains(&format!("unknown DOF `{}`", r.0)))
+            {
+                e.message.push_str(&format!(
+                    " (a rigid gear removed `{gone}`: its angle is {f} × `{kept}`'s; loads on it move there, other tables name `{kept}`)"
+                ));
+            }
+            e
+        })
     }
 
     /// Parses scene text into a document tree (JSON values) with the file's syntax checks.

@@ -49,6 +49,7 @@ mod jacobian;
 mod jenkins;
 mod jenkins_cli;
 mod kink_quadrature;
+mod line_gears;
 mod linear;
 mod linear_sweep;
 mod matrix_import;

@@ -34,7 +34,11 @@ fn solve_at(scene: &Scene, rpm: f64) -> Vec<Complex64> {
 #[test]
 fn marine_line_matches_the_published_frequencies_and_opentorsion() {
     let s = scene("marine_gunter_chen.toml");
-    assert_eq!(s.model.n_dofs(), 6, "four rigid gears remove four of ten angles");
+    assert_eq!(
+        s.model.n_dofs(),
+        6,
+        "four rigid gears remove four of ten angles"
+    );
     let (cpm, rigid) = frequencies_cpm(&s);
     assert_eq!(rigid, 1, "the line floats free, held by damping only");
     for (f, published) in cpm.iter().zip([177.7, 220.2, 1282.6]) {
@@ -48,7 +52,10 @@ fn marine_line_matches_the_published_frequencies_and_opentorsion() {
         2883.382381455156,
     ];
     for (f, reference) in cpm.iter().zip(opentorsion) {
-        assert!((f - reference).abs() < 1e-10 * reference, "{f} vs {reference}");
+        assert!(
+            (f - reference).abs() < 1e-10 * reference,
+            "{f} vs {reference}"
+        );
     }
     // The propeller shaft's torque k (θ_propeller − θ_bull), θ_bull = θ_lp_pinion / 9.4094, at
     // the blade-pass order: openTorsion's amplitudes (measured 1e-13 to 1e-11 apart; its modal
@@ -68,7 +75,11 @@ fn marine_line_matches_the_published_frequencies_and_opentorsion() {
         let q = solve_at(&s, rpm);
         let torque = 93321480.0 * (q[5 * n + prop] - q[5 * n + pinion] / 9.4094);
         let rel = (torque.norm() - reference).abs() / reference;
-        assert!(rel < 1e-10, "{rpm} rpm: {} vs {reference} ({rel:.1e})", torque.norm());
+        assert!(
+            rel < 1e-10,
+            "{rpm} rpm: {} vs {reference} ({rel:.1e})",
+            torque.norm()
+        );
     }
     assert!((s.omega_per_speed - TAU / 60.0).abs() < 1e-15);
 }

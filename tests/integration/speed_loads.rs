@@ -60,7 +60,11 @@ fn laws_give_their_values_at_the_defining_speeds() {
     for (n, a, psi) in [(20.0, 0.05, 0.4), (30.0, 0.03, -0.2), (25.0, 0.04, 0.1)] {
         let z = t.factor(n * RPM);
         assert!((z.norm() - a).abs() < 1e-15, "{n} rpm: |T| = {}", z.norm());
-        assert!((z.arg() + psi).abs() < 1e-13, "{n} rpm: arg T = {}", z.arg());
+        assert!(
+            (z.arg() + psi).abs() < 1e-13,
+            "{n} rpm: arg T = {}",
+            z.arg()
+        );
     }
     // The slope by central differences inside a segment.
     let (w, h) = (27.0 * RPM, 1e-6);
@@ -114,7 +118,11 @@ fn sweep_points_equal_solves_with_the_loads_of_their_speed() {
         .unwrap();
     assert!(branch.points.len() > 10, "{} points", branch.points.len());
     let last = branch.points.last().unwrap();
-    assert!((last.omega - 38.0 * RPM).abs() < 1e-9, "ends at {}", last.omega);
+    assert!(
+        (last.omega - 38.0 * RPM).abs() < 1e-9,
+        "ends at {}",
+        last.omega
+    );
     for p in branch.points.iter().step_by(3) {
         let frozen = model(Some(p.omega));
         let hb = HarmonicBalance::new(&frozen, HarmonicBasis::new(p.omega, 6).unwrap()).unwrap();
@@ -139,7 +147,10 @@ fn a_speed_outside_the_table_is_refused() {
         .unwrap();
     let msg = err.to_string();
     assert!(msg.contains("load on `b` order 2"), "{msg}");
-    assert!(msg.contains("10 to 40 rpm") && msg.contains("needs 45 rpm"), "{msg}");
+    assert!(
+        msg.contains("10 to 40 rpm") && msg.contains("needs 45 rpm"),
+        "{msg}"
+    );
     assert_eq!(err.exit_code(), 2);
     let mut hb = HarmonicBalance::new(&model, HarmonicBasis::new(39.0 * RPM, 5).unwrap()).unwrap();
     let err = hb.set_omega(41.0 * RPM).unwrap_err();
@@ -182,18 +193,33 @@ fn scene_loads_follow_the_reference_shaft_speed() {
     assert_eq!(scene.fundamental_order, 0.5);
     let at = |dof: &str, k: usize, rpm: f64| {
         let i = scene.model.dof_index(dof).unwrap();
-        let l = scene.model.loads().iter().find(|l| l.dof == i && l.order == k).unwrap();
+        let l = scene
+            .model
+            .loads()
+            .iter()
+            .find(|l| l.dof == i && l.order == k)
+            .unwrap();
         let (c, s) = l.at(0.5 * rpm * RPM);
         num_complex::Complex64::new(c, s)
     };
     // Engine order 1.5 is harmonic 3: A e^{-iψ} at the table's speeds (one cylinder, φ_1 = 0).
-    for (rpm, a, psi) in [(1000.0, 100.0, 0.1), (2000.0, 300.0, 0.2), (1500.0, 200.0, 0.15)] {
+    for (rpm, a, psi) in [
+        (1000.0, 100.0, 0.1),
+        (2000.0, 300.0, 0.2),
+        (1500.0, 200.0, 0.15),
+    ] {
         let z = at("crank", 3, rpm);
-        assert!((z.norm() - a).abs() < 1e-12 && (z.arg() + psi).abs() < 1e-14, "{rpm}: {z}");
+        assert!(
+            (z.norm() - a).abs() < 1e-12 && (z.arg() + psi).abs() < 1e-14,
+            "{rpm}: {z}"
+        );
     }
     // A plain load's order counts harmonics of the fundamental; the propeller's ∝ n².
     let z = at("flywheel", 1, 2250.0);
-    assert!((z.norm() - 25.0).abs() < 1e-12 && (z.arg() + 0.75).abs() < 1e-14, "{z}");
+    assert!(
+        (z.norm() - 25.0).abs() < 1e-12 && (z.arg() + 0.75).abs() < 1e-14,
+        "{z}"
+    );
     assert!((at("propeller", 2, 3000.0).re + 160.0).abs() < 1e-10);
     // The constant order 0.5 stays.
     assert!((at("crank", 1, 2400.0).re - 5.0).abs() < 1e-15);
@@ -211,18 +237,31 @@ fn sweeps_within_the_table_run_and_bad_tables_are_refused() {
     };
     let good = write("good.toml", SCENE);
     let out = crate::common::hbal(&["sweep", &good, "--to", "2500", "--json"]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json = crate::common::cli::json_of(&out);
-    let points = json["branches"][0]["points"].as_array().or(json["points"].as_array());
+    let points = json["branches"][0]["points"]
+        .as_array()
+        .or(json["points"].as_array());
     assert!(points.is_some_and(|p| p.len() > 5), "{json}");
     let beyond = crate::common::hbal(&["sweep", &good, "--to", "2600"]);
     let err = String::from_utf8_lossy(&beyond.stderr);
     assert_eq!(beyond.status.code(), Some(2), "{err}");
-    assert!(err.contains("load on `crank` order 3") && err.contains("1000 to 2500 rpm"), "{err}");
+    assert!(
+        err.contains("load on `crank` order 3") && err.contains("1000 to 2500 rpm"),
+        "{err}"
+    );
     assert!(err.contains("1500 to 2600 rpm"), "{err}");
     for (text, path, words) in [
         (
-            SCENE.replace("[1000, 2000, 2500], amplitude = [10, 30", "[1000, 2000, 1900], amplitude = [10, 30"),
+            SCENE.replace(
+                "[1000, 2000, 2500], amplitude = [10, 30",
+                "[1000, 2000, 1900], amplitude = [10, 30",
+            ),
             "loads[1].speed.rpm",
             "strictly increasing",
         ),
@@ -251,7 +290,10 @@ fn sweeps_within_the_table_run_and_bad_tables_are_refused() {
         let out = crate::common::hbal(&["check", &bad]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{path}: {err}");
-        assert!(err.contains(&format!("{path}:")) && err.contains(words), "{path}: {err}");
+        assert!(
+            err.contains(&format!("{path}:")) && err.contains(words),
+            "{path}: {err}"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }
