@@ -327,17 +327,10 @@ fn stability(
     if !settings.stability {
         return StabilityOutcome::NotComputed;
     }
-    // Laws with memory in a large or free-free model: no multipliers rather than wrong ones.
-    if let Some(e) = scene
-        .model
-        .memory_element()
-        .filter(|_| !crate::stability::memory_stability_available(&scene.model))
-    {
-        return StabilityOutcome::Unavailable(format!(
-            "stability not available for laws with memory (element `{}`) in a free-free model or above {} DOFs",
-            e.name(),
-            crate::stability::MAX_MEMORY_DOFS
-        ));
+    // Laws with memory in a large or free-free model, hysteretic damping: no multipliers
+    // rather than wrong ones.
+    if let Some(why) = crate::stability::unavailable(&scene.model) {
+        return StabilityOutcome::Unavailable(format!("stability {why}"));
     }
     if !solution.is_converged() {
         return StabilityOutcome::NotComputed;

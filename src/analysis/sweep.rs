@@ -360,17 +360,7 @@ fn joined(
     Ok((branch, last, note))
 }
 
-/// Why the stability asked for is not available: laws with memory in a free-free model or
-/// above [`MAX_MEMORY_DOFS`](crate::stability::MAX_MEMORY_DOFS).
+/// Why the stability asked for is not available ([`crate::stability::unavailable`]).
 fn stability_unavailable(scene: &Scene, settings: &SweepSettings) -> Option<String> {
-    let available = crate::stability::memory_stability_available(&scene.model);
-    let element = scene
-        .model
-        .memory_element()
-        .filter(|_| settings.stability && !available)?;
-    Some(format!(
-        "not available for laws with memory (element `{}`) in a free-free model or above {} DOFs",
-        element.name(),
-        crate::stability::MAX_MEMORY_DOFS
-    ))
+    crate::stability::unavailable(&scene.model).filter(|_| settings.stability)
 }

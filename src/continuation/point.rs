@@ -121,12 +121,7 @@ impl Continuation {
             Some(_) if p.floquet.is_some() => (p.floquet, None),
             // Laws with memory in a large or free-free model: stability unknown, the branch
             // goes on.
-            Some(_)
-                if model.memory_element().is_some()
-                    && !crate::stability::memory_stability_available(model) =>
-            {
-                (None, None)
-            }
+            Some(_) if crate::stability::unavailable(model).is_some() => (None, None),
             Some(options) => {
                 // The modes and the last orbit correction carry over from point to point; the
                 // reduction's estimate is computed where a label is decided: at the first

@@ -50,6 +50,27 @@ impl DynamicStiffness {
         k0: &DMatrix<f64>,
         augmentation: Option<&DMatrix<f64>>,
     ) -> Result<Self> {
+        Self::build(basis, [m, d0, k0], augmentation, None)
+    }
+
+    /// `Z_k` of a model's dense matrices, with its hysteretic damping `H` (`+ i H` for
+    /// `k >= 1`, [`crate::ModelBuilder::hysteretic`]) and the static augmentation of a
+    /// free-free model, if any.
+    pub fn of_model(
+        basis: &HarmonicBasis,
+        dense: &crate::model::DenseMatrices,
+        augmentation: Option<&DMatrix<f64>>,
+    ) -> Result<Self> {
+        let h = (dense.hysteretic.amax() > 0.0).then_some(&dense.hysteretic);
+        Self::build(basis, [&dense.mass, &dense.d0, &dense.k0], augmentation, h)
+    }
+
+    fn build(
+        basis: &HarmonicBasis,
+        [m, d0, k0]: [&DMatrix<f64>; 3],
+        augmentation: Option<&DMatrix<f64>>,
+        hysteretic: Option<&DMatrix<f64>>,
+    ) -> Result<Self> {
         let n = m.nrows();
         let mut matrices = Vec::with_capacity(basis.harmonics() + 1);
         let mut factors = Vec::with_capacity(basis.harmonics() + 1);
@@ -61,7 +82,11 @@ impl DynamicStiffness {
             if let (0, Some(a)) = (k, augmentation) {
                 z += a.map(|v| Complex64::new(v, 0.0));
             }
-            let scale = k0.amax().max(w * w * m.amax()).max(w * d0.amax());
+            let mut scale = k0.amax().max(w * w * m.amax()).max(w * d0.amax());
+            if let (1.., Some(h)) = (k, hysteretic) {
+                z += h.map(|v| Complex64::new(0.0, v));
+                scale = scale.max(h.amax());
+            }
             let lu = z.clone().lu();
             let u = lu.u();
             let pivots = (0..n).map(|i| u[(i, i)].norm());

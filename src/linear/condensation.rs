@@ -80,7 +80,12 @@ impl Condensation {
                 }
             }
         }
-        let pattern = SparsePattern::new(model.mass(), &model.d0(), &model.k0());
+        let pattern = SparsePattern::with_hysteretic(
+            model.mass(),
+            &model.d0(),
+            &model.k0(),
+            model.hysteretic(),
+        );
         // Rigid-body modes are looked for on every model: a sparse `L D Lᵀ` of a singular
         // `K0` can pass its backward-error test (a rounding-sized pivot), so a failed
         // factorisation is no signal. One factorisation of `K0 + σM` and a few solves, O(n).

@@ -15,26 +15,40 @@ pub struct SparsePattern {
     pub(super) m: Vec<f64>,
     pub(super) d: Vec<f64>,
     pub(super) k: Vec<f64>,
-    /// `(Σ k², Σ k m, Σ m², Σ d²)` over the entries, for [`values_norm`](Self::values_norm).
-    sums: [f64; 4],
+    /// Hysteretic damping `H` (`+ i H` at every `w > 0`); empty without it.
+    pub(super) h: Vec<f64>,
+    /// `(Σ k², Σ k m, Σ m², Σ d², Σ d h, Σ h²)` over the entries, for
+    /// [`values_norm`](Self::values_norm).
+    sums: [f64; 6],
 }
 
 impl SparsePattern {
     /// The union of the nonzeros of `M`, `D0`, `K0` (and the diagonal, so that a structurally
     /// empty row is a clear singular error rather than a missing pivot).
     pub fn new(m: &SparseMatrix, d: &SparseMatrix, k: &SparseMatrix) -> Self {
+        Self::with_hysteretic(m, d, k, &SparseMatrix::zeros(m.n()))
+    }
+
+    /// [`SparsePattern::new`] with hysteretic damping `H`: `Z(w) = -w² M + i (w D0 + H) + K0`
+    /// at `w > 0` (`H` has no static part).
+    pub fn with_hysteretic(
+        m: &SparseMatrix,
+        d: &SparseMatrix,
+        k: &SparseMatrix,
+        h: &SparseMatrix,
+    ) -> Self {
         let n = m.n();
         // Tag each entry with its matrix, merge by position.
         let mut t: Vec<(usize, usize, u8, f64)> =
-            Vec::with_capacity(m.nnz() + d.nnz() + k.nnz() + n);
-        for (tag, a) in [(0u8, m), (1, d), (2, k)] {
+            Vec::with_capacity(m.nnz() + d.nnz() + k.nnz() + h.nnz() + n);
+        for (tag, a) in [(0u8, m), (1, d), (2, k), (4, h)] {
             t.extend(a.iter().map(|(i, j, v)| (i, j, tag, v)));
         }
         t.extend((0..n).map(|i| (i, i, 3, 0.0)));
         t.sort_unstable_by_key(|&(i, j, _, _)| (j, i));
         let mut col_ptr = vec![0; n + 1];
-        let (mut row_idx, mut mv, mut dv, mut kv) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut row_idx, mut mv, mut dv, mut kv, mut hv) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut last = None;
         for (i, j, tag, v) in t {
             if last != Some((i, j)) {
@@ -43,6 +57,7 @@ impl SparsePattern {
                 mv.push(0.0);
                 dv.push(0.0);
                 kv.push(0.0);
+                hv.push(0.0);
                 col_ptr[j + 1] += 1;
             }
             let p = row_idx.len() - 1;
@@ -50,6 +65,7 @@ impl SparsePattern {
                 0 => mv[p] += v,
                 1 => dv[p] += v,
                 2 => kv[p] += v,
+                4 => hv[p] += v,
                 _ => {}
             }
         }
@@ -57,7 +73,17 @@ impl SparsePattern {
             col_ptr[j + 1] += col_ptr[j];
         }
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-        let sums = [dot(&kv, &kv), dot(&kv, &mv), dot(&mv, &mv), dot(&dv, &dv)];
+        let sums = [
+            dot(&kv, &kv),
+            dot(&kv, &mv),
+            dot(&mv, &mv),
+            dot(&dv, &dv),
+            dot(&dv, &hv),
+            dot(&hv, &hv),
+        ];
+        if hv.iter().all(|v| *v == 0.0) {
+            hv.clear();
+        }
         Self {
             n,
             col_ptr,
@@ -65,16 +91,18 @@ impl SparsePattern {
             m: mv,
             d: dv,
             k: kv,
+            h: hv,
             sums,
         }
     }
 
-    /// `true` if `M`, `D0`, `K0` are symmetric to rounding (1e-13 of each one's largest
+    /// `true` if `M`, `D0`, `K0` (and `H`) are symmetric to rounding (1e-13 of each one's largest
     /// entry: an assembly sums `(i, j)` and `(j, i)` in different orders).
     pub(super) fn is_symmetric(&self) -> bool {
         let n = self.n;
         let amax = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-        let tol = [amax(&self.m), amax(&self.d), amax(&self.k)].map(|a| 1e-13 * a);
+        let tol = [amax(&self.m), amax(&self.d), amax(&self.k), amax(&self.h)].map(|a| 1e-13 * a);
+        let h = |p: usize| self.h.get(p).copied().unwrap_or(0.0);
         (0..n).all(|j| {
             (self.col_ptr[j]..self.col_ptr[j + 1]).all(|p| {
                 let i = self.row_idx[p];
@@ -85,6 +113,7 @@ impl SparsePattern {
                         (self.m[q] - self.m[p]).abs() <= tol[0]
                             && (self.d[q] - self.d[p]).abs() <= tol[1]
                             && (self.k[q] - self.k[p]).abs() <= tol[2]
+                            && (h(q) - h(p)).abs() <= tol[3]
                     }
                     Err(_) => false,
                 }
@@ -110,7 +139,16 @@ impl SparsePattern {
     /// Entry `p` of [`values`](Self::values).
     #[inline]
     pub(super) fn value(&self, p: usize, w: f64, s: f64) -> Complex64 {
-        Complex64::new(self.k[p] - (w * w - s) * self.m[p], w * self.d[p])
+        Complex64::new(self.k[p] - (w * w - s) * self.m[p], self.imaginary(p, w))
+    }
+
+    /// `w D0 + H` at entry `p` (`H` at `w > 0` only).
+    #[inline]
+    fn imaginary(&self, p: usize, w: f64) -> f64 {
+        match self.h.get(p) {
+            Some(h) if w > 0.0 => w * self.d[p] + h,
+            _ => w * self.d[p],
+        }
     }
 
     /// `‖Z(w) + s M‖_F` without forming the values: with `a = w² - s`,
@@ -119,9 +157,12 @@ impl SparsePattern {
     /// sums overflow (entries beyond 1e154), from the values, scaled; NaN if a value is not
     /// finite.
     pub(super) fn values_norm(&self, w: f64, s: f64) -> f64 {
-        let [kk, km, mm, dd] = self.sums;
+        let [kk, km, mm, dd, dh, hh] = self.sums;
         let a = w * w - s;
-        let sum = kk - 2.0 * a * km + a * a * mm + w * w * dd;
+        let mut sum = kk - 2.0 * a * km + a * a * mm + w * w * dd;
+        if w > 0.0 {
+            sum += 2.0 * w * dh + hh;
+        }
         if sum.is_finite() {
             return sum.max(0.0).sqrt();
         }
@@ -144,7 +185,7 @@ impl SparsePattern {
         out.fill(Complex64::default());
         for (j, xj) in x.iter().enumerate() {
             for p in self.col_ptr[j]..self.col_ptr[j + 1] {
-                let z = Complex64::new(self.k[p] - (w * w - s) * self.m[p], w * self.d[p]);
+                let z = self.value(p, w, s);
                 out[self.row_idx[p]] += z * xj;
             }
         }

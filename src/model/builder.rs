@@ -26,6 +26,7 @@ pub struct ModelBuilder {
     mass: Option<Input>,
     damping: Option<Input>,
     stiffness: Option<Input>,
+    hysteretic: Option<Input>,
     loads: Vec<(String, usize, f64, f64, Option<SpeedLaw>)>,
     elements: Vec<PendingElement>,
     /// The first triplet outside the DOFs: matrix, row, column.
@@ -39,6 +40,7 @@ impl ModelBuilder {
             mass: None,
             damping: None,
             stiffness: None,
+            hysteretic: None,
             loads: Vec::new(),
             elements: Vec::new(),
             bad_triplet: None,
@@ -68,6 +70,38 @@ impl ModelBuilder {
     /// Structural stiffness K (n × n), default zero.
     pub fn stiffness(mut self, k: DMatrix<f64>) -> Self {
         self.stiffness = Some(Input::Dense(k));
+        self
+    }
+
+    /// Hysteretic (structural) damping `H` (n × n), default zero: the damping force of
+    /// harmonic `k >= 1` is `i H Q_k`, the same at every frequency, i.e. a viscous damping
+    /// `c(ω) = H / ω` (a loss factor η on a stiffness k gives `H = η k`). It has no static part
+    /// and no time-domain form: the time integration and the Floquet analysis refuse it.
+    ///
+    /// ```
+    /// use hbal::nalgebra::DMatrix;
+    /// // x'' + x = cos(t/2) with H = 0.1: |X| = 1 / |1 - 1/4 + 0.1 i|.
+    /// let model = hbal::Model::builder(&["x"])
+    ///     .mass_diagonal(&[1.0])
+    ///     .stiffness(DMatrix::from_element(1, 1, 1.0))
+    ///     .hysteretic(DMatrix::from_element(1, 1, 0.1))
+    ///     .load("x", 1, 1.0, 0.0)
+    ///     .build()?;
+    /// let hb = hbal::HarmonicBalance::new(&model, hbal::HarmonicBasis::new(0.5, 2)?)?;
+    /// let sol = hbal::Newton::new().solve(&hb, &mut hb.workspace())?;
+    /// let x = sol.harmonics()[1].norm();
+    /// assert!((x - 1.0 / (0.75f64.powi(2) + 0.01).sqrt()).abs() < 1e-12);
+    /// # Ok::<(), hbal::Error>(())
+    /// ```
+    pub fn hysteretic(mut self, h: DMatrix<f64>) -> Self {
+        self.hysteretic = Some(Input::Dense(h));
+        self
+    }
+
+    /// Hysteretic damping `H` from triplets (see [`ModelBuilder::hysteretic`],
+    /// [`ModelBuilder::mass_triplets`]).
+    pub fn hysteretic_triplets(mut self, triplets: &[(usize, usize, f64)]) -> Self {
+        self.hysteretic = self.assemble(triplets, "hysteretic damping");
         self
     }
 
@@ -246,6 +280,10 @@ impl ModelBuilder {
             Some(k) => check_matrix("stiffness matrix", k, n)?,
             None => SparseMatrix::zeros(n),
         };
+        let hysteretic = match self.hysteretic.clone() {
+            Some(h) => check_matrix("hysteretic damping matrix", h, n)?,
+            None => SparseMatrix::zeros(n),
+        };
 
         let mut loads = Vec::with_capacity(self.loads.len());
         for (dof, order, c, s, law) in &self.loads {
@@ -334,6 +372,7 @@ impl ModelBuilder {
             mass,
             damping,
             stiffness,
+            hysteretic,
             loads,
             elements,
         })

@@ -42,6 +42,8 @@ pub struct DenseMatrices {
     pub d0: DMatrix<f64>,
     /// `K0 = K + Σ k0_e w_e w_eᵀ`.
     pub k0: DMatrix<f64>,
+    /// Hysteretic damping H (zero unless the model has it).
+    pub hysteretic: DMatrix<f64>,
 }
 
 /// A validated model: DOF names, constant matrices (sparse), loads and force elements.
@@ -51,6 +53,8 @@ pub struct Model {
     pub(crate) mass: SparseMatrix,
     pub(crate) damping: SparseMatrix,
     pub(crate) stiffness: SparseMatrix,
+    /// Hysteretic damping `H` ([`ModelBuilder::hysteretic`]).
+    pub(crate) hysteretic: SparseMatrix,
     pub(crate) loads: Vec<Load>,
     pub(crate) elements: Vec<Element>,
 }
@@ -142,6 +146,7 @@ impl Model {
             stiffness: self.stiffness.to_dense(),
             d0: self.d0().to_dense(),
             k0: self.k0().to_dense(),
+            hysteretic: self.hysteretic.to_dense(),
         })
     }
 
@@ -169,6 +174,29 @@ impl Model {
         self.elements
             .iter()
             .all(|e| e.law().is_linear_time_invariant())
+    }
+
+    /// Hysteretic damping `H` (zero unless given, [`ModelBuilder::hysteretic`]).
+    pub fn hysteretic(&self) -> &SparseMatrix {
+        &self.hysteretic
+    }
+
+    /// `true` if the model has hysteretic damping: a frequency-domain law without a
+    /// time-domain form.
+    pub fn has_hysteretic_damping(&self) -> bool {
+        self.hysteretic.nnz() > 0 && self.hysteretic.amax() > 0.0
+    }
+
+    /// An error for `analysis` (a time integration, a Floquet analysis) where the model has
+    /// hysteretic damping, which has no time-domain form.
+    pub fn refuse_hysteretic(&self, analysis: &str) -> Result<()> {
+        if self.has_hysteretic_damping() {
+            return Err(Error::InvalidElement {
+                context: analysis.into(),
+                reason: "the model has hysteretic damping (a loss factor: c = H/ω at each harmonic's frequency ω), which has no time-domain form; it exists in the frequency domain only".into(),
+            });
+        }
+        Ok(())
     }
 
     /// `K0 = K + Σ_e k0_e w_e w_eᵀ`, the constant stiffness of the paper's split.

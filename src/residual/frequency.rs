@@ -17,13 +17,7 @@ fn free_dynamic_stiffness(
     dense: &crate::model::DenseMatrices,
     rigid: &crate::model::RigidModes,
 ) -> Result<DynamicStiffness> {
-    DynamicStiffness::with_static_augmentation(
-        basis,
-        &dense.mass,
-        &dense.d0,
-        &dense.k0,
-        Some(&rigid.augmentation()),
-    )
+    DynamicStiffness::of_model(basis, dense, Some(&rigid.augmentation()))
 }
 
 impl HarmonicBalance<'_> {
@@ -110,7 +104,7 @@ impl HarmonicBalance<'_> {
     pub(super) fn factor_full(&mut self, mean_load: &[f64]) -> Result<()> {
         let (model, basis) = (self.model, self.basis);
         let dense = model.dense("full formulation")?;
-        self.z = match DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0) {
+        self.z = match DynamicStiffness::of_model(&basis, &dense, None) {
             Err(e @ Error::SingularDynamicStiffness { harmonic: 0, .. }) => {
                 let Some(rigid) = crate::model::rigid::find_dense(model, &dense) else {
                     return Err(e);
@@ -164,7 +158,7 @@ impl HarmonicBalance<'_> {
         };
         self.z = match &self.rigid {
             Some(rigid) => free_dynamic_stiffness(&basis, dense, rigid)?,
-            None => DynamicStiffness::new(&basis, &dense.mass, &dense.d0, &dense.k0)?,
+            None => DynamicStiffness::of_model(&basis, dense, None)?,
         };
         self.basis = basis;
         self.refresh_speed_loads()?;

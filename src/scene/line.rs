@@ -35,6 +35,10 @@ struct Line {
     /// Rigid gear pairs, each removing one angle (see `line_gears.rs`).
     #[serde(default)]
     gears: Vec<super::line_gears::RigidGear>,
+    /// The loss factor η of every shaft without its own: hysteretic damping `η k`
+    /// (`c = η k / ω` at each harmonic's frequency ω).
+    #[serde(default)]
+    loss_factor: f64,
     /// Damping ratios of the undamped modes (see `line_modal.rs`).
     #[serde(default)]
     modal_damping: Option<super::line_modal::ModalDamping>,
@@ -59,6 +63,8 @@ struct Shaft {
     stiffness: Option<f64>,
     #[serde(default)]
     damping: f64,
+    /// Its loss factor η (default the line's `loss_factor`).
+    loss_factor: Option<f64>,
     length: Option<f64>,
     outer_diameter: Option<f64>,
     inner_diameter: Option<f64>,
@@ -66,7 +72,7 @@ struct Shaft {
 }
 
 /// The fields `[line]` builds.
-const BUILT: [&str; 4] = ["dofs", "mass", "stiffness", "damping"];
+const BUILT: [&str; 5] = ["dofs", "mass", "stiffness", "damping", "hysteretic_damping"];
 
 /// A disk a rigid gear removed: its name, the kept disk's and the factor, `θ = f θ_kept`.
 pub(super) type Removed = (String, String, f64);
@@ -85,7 +91,7 @@ pub(super) fn expand(doc: &mut Value) -> Result<Vec<Removed>, (String, String)> 
     if let Some(field) = BUILT.iter().find(|f| map.contains_key(**f)) {
         return Err((
             "line".into(),
-            format!("`line` builds `dofs`, `mass`, `stiffness` and `damping`, and the scene also gives `{field}`: give one or the other"),
+            format!("`line` builds `dofs`, `mass`, `stiffness`, `damping` and `hysteretic_damping`, and the scene also gives `{field}`: give one or the other"),
         ));
     }
     let line: Line = serde_path_to_error::deserialize(value).map_err(|x| {
@@ -117,6 +123,13 @@ pub(super) fn expand(doc: &mut Value) -> Result<Vec<Removed>, (String, String)> 
         .collect();
     let mut stiffness = Vec::new();
     let mut damping: Vec<Value> = Vec::new();
+    let mut hysteretic: Vec<Value> = Vec::new();
+    if !(line.loss_factor.is_finite() && line.loss_factor >= 0.0) {
+        return Err((
+            "line.loss_factor".into(),
+            format!("must be finite and >= 0, got {}", line.loss_factor),
+        ));
+    }
     let mut inertia = vec![0.0; kept.len()];
     for (i, disk) in line.disks.iter().enumerate() {
         let (r, f) = at[i];
@@ -147,6 +160,16 @@ pub(super) fn expand(doc: &mut Value) -> Result<Vec<Removed>, (String, String)> 
         couple(&mut stiffness, at[f], at[t], k);
         if shaft.damping != 0.0 {
             couple(&mut damping, at[f], at[t], shaft.damping);
+        }
+        let eta = shaft.loss_factor.unwrap_or(line.loss_factor);
+        if !(eta.is_finite() && eta >= 0.0) {
+            return Err((
+                at_field("loss_factor"),
+                format!("must be finite and >= 0, got {eta}"),
+            ));
+        }
+        if eta != 0.0 {
+            couple(&mut hysteretic, at[f], at[t], eta * k);
         }
     }
     if let Some(r) = inertia.iter().position(|j| *j <= 0.0) {
@@ -179,7 +202,11 @@ pub(super) fn expand(doc: &mut Value) -> Result<Vec<Removed>, (String, String)> 
     }
     map.insert("dofs".into(), json!(names));
     map.insert("mass".into(), json!({ "triplets": mass }));
-    for (field, entries) in [("stiffness", stiffness), ("damping", damping)] {
+    for (field, entries) in [
+        ("stiffness", stiffness),
+        ("damping", damping),
+        ("hysteretic_damping", hysteretic),
+    ] {
         if !entries.is_empty() {
             map.insert(
                 field.into(),

@@ -78,6 +78,7 @@ pub(super) struct Structure {
     mass: Source,
     damping: Option<Source>,
     stiffness: Option<Source>,
+    hysteretic: Option<Source>,
 }
 
 /// The directory that paths in the scene are relative to: the scene file's, if it exists, else
@@ -90,12 +91,12 @@ pub(super) fn base_dir(scene_file: &str) -> PathBuf {
 }
 
 impl Structure {
-    /// Reads `dofs`, `mass`, `damping` and `stiffness`; files are relative to `base`.
+    /// Reads `dofs`, `mass`, `damping`, `stiffness` and `hysteretic_damping`; files are
+    /// relative to `base`.
     pub(super) fn read(
         dofs: &Value,
         mass: &Value,
-        damping: Option<&Value>,
-        stiffness: Option<&Value>,
+        [damping, stiffness, hysteretic]: [Option<&Value>; 3],
         base: &Path,
     ) -> Result<Structure, FieldError> {
         let dofs = dofs::read(dofs, base)?;
@@ -104,6 +105,9 @@ impl Structure {
             mass: matrix("mass", mass)?,
             damping: damping.map(|v| matrix("damping", v)).transpose()?,
             stiffness: stiffness.map(|v| matrix("stiffness", v)).transpose()?,
+            hysteretic: hysteretic
+                .map(|v| matrix("hysteretic_damping", v))
+                .transpose()?,
             dofs,
         })
     }
@@ -121,10 +125,15 @@ impl Structure {
             Some(Source::Dense(m)) => b.damping(m.clone()),
             Some(Source::Triplets { entries, .. }) => b.damping_triplets(entries),
         };
-        match &self.stiffness {
+        b = match &self.stiffness {
             None => b,
             Some(Source::Dense(m)) => b.stiffness(m.clone()),
             Some(Source::Triplets { entries, .. }) => b.stiffness_triplets(entries),
+        };
+        match &self.hysteretic {
+            None => b,
+            Some(Source::Dense(m)) => b.hysteretic(m.clone()),
+            Some(Source::Triplets { entries, .. }) => b.hysteretic_triplets(entries),
         }
     }
 

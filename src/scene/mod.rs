@@ -96,6 +96,9 @@ struct SceneFile {
     damping: Option<Value>,
     #[serde(default)]
     stiffness: Option<Value>,
+    /// Hysteretic damping H (`+ i H` at every harmonic k >= 1), as `damping`.
+    #[serde(default)]
+    hysteretic_damping: Option<Value>,
     fundamental: fundamental::Fundamental,
     harmonics: harmonics::Harmonics,
     /// Piston-engine excitation per order and cylinder.
@@ -251,8 +254,11 @@ impl SceneFile {
         let structure = matrix::Structure::read(
             &self.dofs,
             &self.mass,
-            self.damping.as_ref(),
-            self.stiffness.as_ref(),
+            [
+                self.damping.as_ref(),
+                self.stiffness.as_ref(),
+                self.hysteretic_damping.as_ref(),
+            ],
             &matrix::base_dir(file),
         )
         .map_err(|(path, message)| err(&path, message))?;

@@ -127,6 +127,23 @@ use crate::error::Result;
 use crate::model::Model;
 use crate::solution::Solution;
 
+/// Why no Floquet multipliers are computed for `model`, if they are not: laws with memory in
+/// a free-free model or above [`MAX_MEMORY_DOFS`]; hysteretic damping, which has no
+/// time-domain form (and so no variational equation).
+pub fn unavailable(model: &Model) -> Option<String> {
+    if model.has_hysteretic_damping() {
+        return Some("not available with hysteretic damping (a loss factor, c = H/ω): it has no time-domain form".into());
+    }
+    let element = model
+        .memory_element()
+        .filter(|_| !memory_stability_available(model))?;
+    Some(format!(
+        "not available for laws with memory (element `{}`) in a free-free model or above {} DOFs",
+        element.name(),
+        MAX_MEMORY_DOFS
+    ))
+}
+
 /// Floquet multipliers of `solution` (a periodic solution of `model`) with the default
 /// [`FloquetOptions`].
 pub fn floquet(model: &Model, solution: &Solution) -> Result<Floquet> {

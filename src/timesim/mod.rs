@@ -143,6 +143,7 @@ impl TimeSimulation {
     /// Integrates `model` at fundamental `omega` (rad/s) to its periodic steady state.
     pub fn run(&self, model: &Model, omega: f64) -> Result<TimeResponse> {
         self.validate()?;
+        model.refuse_hysteretic("time simulation")?;
         crate::error::check_positive("time simulation", "omega", omega)?;
         let n = model.n_dofs();
         let period = TAU / omega;

@@ -83,3 +83,196 @@ fn marine_line_matches_the_published_frequencies_and_opentorsion() {
     }
     assert!((s.omega_per_speed - TAU / 60.0).abs() < 1e-15);
 }
+
+/// The diesel line's inertias (kg m²), shaft stiffnesses (N m/rad) and throw dampers.
+const DIESEL_J: [f64; 9] = [
+    0.0170, 0.0090, 0.0467, 0.0327, 0.0467, 0.0467, 0.0327, 0.0487, 2.0750,
+];
+const DIESEL_K: [f64; 8] = [
+    1.106e6, 1.631e6, 1.253e6, 1.253e6, 1.678e6, 1.253e6, 1.253e6, 1.976e6,
+];
+
+/// Σ over the harmonics of each shaft's torque amplitude `|k (Q_a − Q_b)|`, openTorsion's
+/// `VT_sum`.
+fn shaft_torque_sums(q: &[Complex64]) -> Vec<f64> {
+    let n = DIESEL_J.len();
+    (0..DIESEL_K.len())
+        .map(|s| {
+            (1..q.len() / n)
+                .map(|k| (DIESEL_K[s] * (q[k * n + s] - q[k * n + s + 1])).norm())
+                .sum()
+        })
+        .collect()
+}
+
+/// Mendes et al.'s six-cylinder diesel: openTorsion's natural frequencies; its run-up's shaft
+/// torques where its quirks are written too (orders 0.499 k from its Fourier grid, its firing
+/// phase sign); the scene as written (half orders, firing order 1-5-3-6-2-4) between two
+/// table speeds against a solve written here (the table interpolated, `Z = −ω² M + iω C +
+/// (1 + 0.035 i) K`).
+#[test]
+fn diesel_line_matches_opentorsion_and_an_independent_solve() {
+    let path = crate::common::cli::scenes_dir().join("diesel_six_cylinder.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let s = Scene::from_str(&text, "diesel.toml").unwrap();
+    let (cpm, rigid) = frequencies_cpm(&s);
+    assert_eq!(rigid, 1);
+    let opentorsion_hz = [
+        216.58360523507628,
+        592.7404802480227,
+        984.922963985233,
+        1171.0174081899745,
+        1415.9950172062609,
+        1660.0439116801897,
+        1794.3875797468231,
+        2993.4735625695344,
+    ];
+    for (f, hz) in cpm.iter().zip(opentorsion_hz) {
+        assert!((f / 60.0 - hz).abs() < 1e-10 * hz, "{f} cpm vs {hz} Hz");
+    }
+    // openTorsion's own orders and phases.
+    let mut replica = text.replace(
+        "fundamental = { rpm = 1000 }",
+        "fundamental = { rpm = 1000, order = 0.499 }",
+    );
+    for k in (1..=24).rev() {
+        let half = format!("\norder = {:?}\n", k as f64 / 2.0);
+        replica = replica.replace(&half, &format!("\norder = {:?}\n", 0.499 * k as f64));
+    }
+    let angles: Vec<String> = [0.0, 4.0, 2.0, 5.0, 1.0, 3.0]
+        .iter()
+        .map(|f: &f64| format!("{:?}", -f * TAU / 3.0))
+        .collect();
+    replica = replica.replace(
+        "firing_order = [1, 5, 3, 6, 2, 4]",
+        &format!("firing_angles = [{}]", angles.join(", ")),
+    );
+    let r = Scene::from_str(&replica, "replica.toml").unwrap();
+    assert_eq!(r.fundamental_order, 0.499);
+    for (rpm, reference) in [
+        (
+            1000.0,
+            [
+                56.009737615655695,
+                85.3145147067093,
+                4106.411047917853,
+                5302.518306205261,
+                3789.9595598285186,
+                6244.4366530890875,
+                5925.215002324742,
+                2825.9136087512034,
+            ],
+        ),
+        (
+            1500.0,
+            [
+                244.34522648046425,
+                370.5067876275072,
+                4832.324630740364,
+                6246.126434227364,
+                5124.899711157206,
+                7765.86672900462,
+                7499.061704186673,
+                4401.031632531314,
+            ],
+        ),
+        (
+            2000.0,
+            [
+                439.13706619740447,
+                665.2941737029563,
+                5303.819757505383,
+                6965.862778523797,
+                6174.942663699478,
+                8857.201998417804,
+                8650.605195802178,
+                5959.822052802842,
+            ],
+        ),
+        (
+            2550.0,
+            [
+                209.1718761019844,
+                315.9482147786628,
+                2260.9810459593054,
+                2793.5907707587767,
+                2493.9857116782596,
+                3567.8142056956667,
+                3436.5897574502264,
+                2243.9802389591277,
+            ],
+        ),
+    ] {
+        let sums = shaft_torque_sums(&solve_at(&r, rpm));
+        for (s, (a, b)) in sums.iter().zip(reference).enumerate() {
+            assert!(
+                (a - b).abs() < 1e-10 * b,
+                "{rpm} rpm shaft {s}: {a} vs openTorsion {b}"
+            );
+        }
+    }
+    // The scene as written, at 1730 rpm (between the table's 1700 and 1750), against a direct
+    // solve per order with the table interpolated here.
+    let rpm = 1730.0;
+    let q = solve_at(&s, rpm);
+    let n = DIESEL_J.len();
+    let table = table_of(&text);
+    let firing = [0.0, 4.0, 2.0, 5.0, 1.0, 3.0].map(|p: f64| p * 2.0 * TAU / 6.0);
+    let mut worst: f64 = 0.0;
+    for (k, (speeds, amplitude, phase)) in table.iter().enumerate() {
+        let o = (k + 1) as f64 / 2.0;
+        let w = o * rpm * TAU / 60.0;
+        let i = speeds.iter().position(|&v| v > rpm).unwrap() - 1;
+        let t = (rpm - speeds[i]) / (speeds[i + 1] - speeds[i]);
+        let a = amplitude[i] + t * (amplitude[i + 1] - amplitude[i]);
+        let psi = phase[i] + t * (phase[i + 1] - phase[i]);
+        let mut z = nalgebra::DMatrix::<Complex64>::zeros(n, n);
+        let mut f = nalgebra::DVector::<Complex64>::zeros(n);
+        for d in 0..n {
+            z[(d, d)] += -w * w * DIESEL_J[d]
+                + Complex64::new(0.0, w * if (2..8).contains(&d) { 2.0 } else { 0.0 });
+        }
+        for (e, kk) in DIESEL_K.iter().enumerate() {
+            let c = Complex64::new(*kk, 0.035 * kk);
+            z[(e, e)] += c;
+            z[(e + 1, e + 1)] += c;
+            z[(e, e + 1)] -= c;
+            z[(e + 1, e)] -= c;
+        }
+        for (c, phi) in firing.iter().enumerate() {
+            // A cos(o(φ − φ_c) + ψ) = Re[A e^{-i(oφ_c − ψ)} e^{iωt}].
+            f[2 + c] = Complex64::from_polar(a, -(o * phi - psi));
+        }
+        let x = z.lu().solve(&f).unwrap();
+        let h = k + 1; // order k/2 is harmonic k + 1 of the fundamental of order 1/2
+        let scale = x.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        for d in 0..n {
+            worst = worst.max((q[h * n + d] - x[d]).norm() / scale);
+        }
+    }
+    assert!(
+        worst < 1e-10,
+        "largest difference {worst:.1e} of each order's largest amplitude"
+    );
+}
+
+/// The `[[engine.orders]]` tables of the diesel scene: speeds, amplitudes and phases per order.
+fn table_of(text: &str) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+    let doc: toml::Value = toml::from_str(text).unwrap();
+    let list = |v: &toml::Value| -> Vec<f64> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_float().or(x.as_integer().map(|i| i as f64)).unwrap())
+            .collect()
+    };
+    doc["engine"]["orders"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| {
+            let s = &o["speed"];
+            (list(&s["rpm"]), list(&s["amplitude"]), list(&s["phase"]))
+        })
+        .collect()
+}

@@ -47,6 +47,7 @@ pub(super) fn checked(
             });
         }
     }
+    model.refuse_hysteretic("method `piecewise_exact`")?;
     let dense = model.dense("piecewise_exact")?;
     if dense.mass.clone().lu().try_inverse().is_none() {
         return Err(Error::MassNotPositiveDefinite {

@@ -60,6 +60,7 @@ impl FloquetOptions {
                 "positive (a multiple of the highest harmonic's frequency)",
             ));
         }
+        model.refuse_hysteretic("floquet")?;
         // The variational equation of a law with memory is not the one of `(∂f/∂u, ∂f/∂u̇)`:
         // shooting on the time-domain model with the laws' states instead.
         if model.memory_element().is_some() {
