@@ -45,6 +45,7 @@ mod hard_cases;
 mod hostile_input;
 mod hostile_non_finite;
 mod hostile_property;
+mod hysteretic;
 mod jacobian;
 mod jenkins;
 mod jenkins_cli;

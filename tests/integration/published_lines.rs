@@ -276,3 +276,81 @@ fn table_of(text: &str) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
         })
         .collect()
 }
+
+/// Sopanen et al.'s wind turbine: openTorsion's frequencies and its forced response (the sum
+/// over the generator orders of each shaft's torque amplitude) inside the linear part of the
+/// generator torque, 2 % modal damping computed here and there.
+#[test]
+fn wind_turbine_matches_opentorsion() {
+    let s = scene("wind_turbine_sopanen.toml");
+    let (cpm, rigid) = frequencies_cpm(&s);
+    assert_eq!(
+        rigid, 1,
+        "nothing holds the line: modal damping leaves the rigid mode free"
+    );
+    for (f, hz) in cpm.iter().zip([9.285125147092211, 164.58446925256425]) {
+        assert!((f / 60.0 - hz).abs() < 1e-10 * hz, "{f} cpm vs {hz} Hz");
+    }
+    let k = [3.67e8, 5.496e9];
+    for (rpm, reference) in [
+        (5.0, [2859.858641227879, 2617.3791326657265]),
+        (10.0, [1537.082811164083, 8297.845193417532]),
+        (13.6, [5567.605866873061, 79690.05502801875]),
+    ] {
+        let q = solve_at(&s, rpm);
+        for (j, (kj, want)) in k.iter().zip(reference).enumerate() {
+            let got: f64 = (1..=8)
+                .map(|h| (kj * (q[h * 3 + j] - q[h * 3 + j + 1])).norm())
+                .sum();
+            assert!(
+                (got - want).abs() < 1e-10 * want,
+                "{rpm} rpm shaft {j}: {got} vs openTorsion {want}"
+            );
+        }
+    }
+}
+
+/// The diesel's run-up 1000 → 2550 rpm in one `hbal sweep` with the order torques over speed:
+/// the flywheel shaft's torque (the sum over the orders) peaks where openTorsion's run-up does
+/// (2175 rpm on its 25 rpm grid), and the stability is said to be unavailable, not guessed.
+#[test]
+fn diesel_run_up_in_one_sweep() {
+    let scene = crate::common::cli::scenes_dir().join("diesel_six_cylinder.toml");
+    let scene = scene.to_string_lossy();
+    let out = crate::common::hbal(&["sweep", &scene, "--to", "2550", "--json"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json = crate::common::cli::json_of(&out);
+    let points = json["points"].as_array().unwrap();
+    assert!(points.len() > 50, "{} points", points.len());
+    let speed = |p: &serde_json::Value| p["speed"].as_f64().unwrap();
+    assert_eq!(speed(&points[0]), 1000.0);
+    assert!((speed(points.last().unwrap()) - 2550.0).abs() < 1e-9);
+    let torque = |p: &serde_json::Value| -> f64 {
+        let h = |dof: usize| p["harmonics"][dof].as_array().unwrap().clone();
+        let (a, b) = (h(7), h(8));
+        a.iter()
+            .zip(&b)
+            .skip(1)
+            .map(|(x, y)| {
+                let c = x["cos"].as_f64().unwrap() - y["cos"].as_f64().unwrap();
+                let s = x["sin"].as_f64().unwrap() - y["sin"].as_f64().unwrap();
+                DIESEL_K[7] * c.hypot(s)
+            })
+            .sum()
+    };
+    let peak = points
+        .iter()
+        .max_by(|a, b| torque(a).total_cmp(&torque(b)))
+        .unwrap();
+    assert!(
+        (2150.0..2200.0).contains(&speed(peak)),
+        "peak at {} rpm",
+        speed(peak)
+    );
+    assert!(points.iter().all(|p| p["stable"].is_null()));
+}
