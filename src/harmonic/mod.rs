@@ -18,7 +18,7 @@ mod packing;
 pub use aft::{AftPlan, AftScratch};
 pub use basis::HarmonicBasis;
 pub(crate) use dynamic_stiffness::non_finite_stiffness;
-pub use dynamic_stiffness::DynamicStiffness;
+pub use dynamic_stiffness::{DynamicStiffness, SINGULAR_PIVOT};
 pub use packing::{Part, RealLayout};
 
 use num_complex::Complex64;

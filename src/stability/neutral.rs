@@ -54,9 +54,16 @@ fn split_by_damping(sys: &Coordinates, s: DMatrix<f64>) -> NeutralModes {
     }
 }
 
-/// The rigid-body modes in the model's DOFs.
+/// The rigid-body modes in the model's DOFs: none unless `K0` is singular by the test the
+/// harmonic balance makes of `Z_0` (its smallest LU pivot at most
+/// [`SINGULAR_PIVOT`](crate::harmonic::SINGULAR_PIVOT) of its largest entry), so that a
+/// motion the solve treated as restrained (a soft ground spring, even one far below the
+/// shafts' stiffness) keeps its multipliers among those that decide stability.
 fn in_dofs(sys: &Coordinates) -> DMatrix<f64> {
     let n = sys.len();
+    if !static_singular(&sys.model.k0().to_dense()) {
+        return DMatrix::zeros(n, 0);
+    }
     // G = [K/|K|; w_eᵀ/|w_e|]; its null space is the set of motions harmonic 0 cannot fix.
     let mut g = DMatrix::<f64>::zeros(n, n);
     let mut add_rows = |rows: &DMatrix<f64>| {
@@ -87,6 +94,19 @@ fn in_dofs(sys: &Coordinates) -> DMatrix<f64> {
         r.set_column(c, &eig.eigenvectors.column(i));
     }
     r
+}
+
+/// `true` if `K0` is singular as `Z_0` is judged: its smallest LU pivot at most
+/// `SINGULAR_PIVOT` times its largest entry.
+fn static_singular(k0: &DMatrix<f64>) -> bool {
+    let scale = k0.amax();
+    if scale == 0.0 {
+        return true;
+    }
+    let lu = k0.clone().lu();
+    let u = lu.u();
+    let smallest = (0..k0.nrows()).fold(f64::INFINITY, |m, i| m.min(u[(i, i)].abs()));
+    smallest <= crate::harmonic::SINGULAR_PIVOT * scale
 }
 
 /// The rigid-body modes of the model inside the span of the basis `V`, by the same test as in

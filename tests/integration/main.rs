@@ -75,6 +75,7 @@ mod stability_harmonic_orbit;
 mod stability_memory;
 mod stability_rooms;
 mod stability_time_domain;
+mod stability_weak_ground;
 mod stability_worker;
 mod tail_correction;
 mod threads;
