@@ -132,8 +132,8 @@ fn diesel_line_matches_opentorsion_and_an_independent_solve() {
     }
     // openTorsion's own orders and phases.
     let mut replica = text.replace(
-        "fundamental = { rpm = 1000 }",
-        "fundamental = { rpm = 1000, order = 0.499 }",
+        "fundamental = { rpm = 1500 }",
+        "fundamental = { rpm = 1500, order = 0.499 }",
     );
     for k in (1..=24).rev() {
         let half = format!("\norder = {:?}\n", k as f64 / 2.0);
@@ -317,7 +317,7 @@ fn wind_turbine_matches_opentorsion() {
 fn diesel_run_up_in_one_sweep() {
     let scene = crate::common::cli::scenes_dir().join("diesel_six_cylinder.toml");
     let scene = scene.to_string_lossy();
-    let out = crate::common::hbal(&["sweep", &scene, "--to", "2550", "--json"]);
+    let out = crate::common::hbal(&["sweep", &scene, "--from", "1000", "--to", "2550", "--json"]);
     assert_eq!(
         out.status.code(),
         Some(0),

@@ -111,7 +111,7 @@ fn bad_lines_name_the_table_and_field() {
             "inertia = 0.5",
             "inertia = -0.5",
             "line.disks[0].inertia",
-            "finite and > 0",
+            "finite and >= 0",
         ),
         (
             "damping = 40.0 }",
