@@ -54,7 +54,7 @@ impl DynamicStiffness {
     }
 
     /// `Z_k` of a model's dense matrices, with its hysteretic damping `H` (`+ i H` for
-    /// `k >= 1`, [`crate::ModelBuilder::hysteretic`]) and the static augmentation of a
+    /// `k >= 1`, [`crate::model::ModelBuilder::hysteretic`]) and the static augmentation of a
     /// free-free model, if any.
     pub fn of_model(
         basis: &HarmonicBasis,
