@@ -79,6 +79,7 @@ pub struct CompareAnalysis {
 /// An unknown method or a bad tolerance (bad input), a model the harmonic balance refuses,
 /// a method that fails outright, a time integration that fails.
 pub fn compare(scene: &Scene, settings: &CompareSettings) -> Result<CompareAnalysis> {
+    scene.require_operating_point("compare")?;
     let overrides = Overrides {
         tolerance: settings.tolerance,
         formulation: settings.formulation,

@@ -40,8 +40,9 @@ pub struct ModesAnalysis {
     pub file: String,
     /// The scene's speed unit.
     pub unit: String,
-    /// The scene's speed, where the model is linearised.
-    pub operating_speed: f64,
+    /// The scene's speed, where the model is linearised; `None` for a scene without an
+    /// operating point (no `fundamental`, `harmonics`).
+    pub operating_speed: Option<f64>,
     /// The critical-speed range (the scene's unit).
     pub range: (f64, f64),
     /// The frequency limit (Hz; infinite for every mode).
@@ -130,6 +131,15 @@ pub fn modes(scene: &Scene, settings: &ModesSettings) -> Result<ModesAnalysis> {
         .map(|(o, _)| o)
         .collect();
     let per_unit = scene.omega_per_speed / scene.fundamental_order;
+    // Without an operating point (and `--to`), up to a quarter above the highest critical speed.
+    let to = match (&natural, settings.to, scene.operating_point) {
+        (Some(nf), None, false) => critical_speeds(nf, &orders, per_unit, (from, f64::MAX))
+            .iter()
+            .map(|c| 1.25 * c.speed)
+            .fold(None, |m: Option<f64>, s| Some(m.map_or(s, |m| m.max(s))))
+            .unwrap_or(to),
+        _ => to,
+    };
     let critical = natural
         .as_ref()
         .map(|nf| critical_speeds(nf, &orders, per_unit, (from, to)))
@@ -137,7 +147,7 @@ pub fn modes(scene: &Scene, settings: &ModesSettings) -> Result<ModesAnalysis> {
     Ok(ModesAnalysis {
         file: scene.file.clone(),
         unit: scene.speed_unit.to_string(),
-        operating_speed: speed,
+        operating_speed: scene.operating_point.then_some(speed),
         range: (from, to),
         max_hz,
         termination,
@@ -168,6 +178,8 @@ fn operating_point(
         let natural = crate::report::natural_frequencies_at(model, &rest, max_hz)?;
         return Ok((Termination::Converged, Some(natural), true));
     }
+    // A nonlinear model's modes depend on its orbit, at the scene's operating point.
+    scene.require_operating_point("modes of a model nonlinear in the state")?;
     let hb = HarmonicBalance::with_formulation(model, scene.basis, settings.formulation)?;
     let sol = scene.method.solve(&hb, None, &mut hb.workspace())?;
     let natural = match sol.is_converged() {

@@ -59,7 +59,11 @@ pub fn check_sweep_start(scene: &Scene, omega: f64, formulation: crate::Formulat
 /// Checks `scene` as a solve would before its first iteration (`hbal check`): its harmonic
 /// balance builds at the scene's speed, with automatic harmonics at their first level (H
 /// raised to the load and mesh orders).
+/// Without an operating point (no `fundamental`, `harmonics`), only the model is checked.
 pub fn check(scene: &Scene) -> Result<()> {
+    if !scene.operating_point {
+        return Ok(());
+    }
     harmonic_balance(scene, scene.basis, crate::Formulation::Auto).map(|_| ())
 }
 

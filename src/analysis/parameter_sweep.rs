@@ -196,6 +196,7 @@ fn check(document: &Value, file: &str, settings: &ParameterSweepSettings) -> Res
         return Err(bad("--parameter", changes_dofs(name)));
     }
     let first = scene_at(document, file, settings, settings.from)?;
+    first.require_operating_point("sweep")?;
     if let Some((i, x)) = values(settings)
         .into_iter()
         .enumerate()

@@ -165,6 +165,7 @@ impl SolveAnalysis {
 /// Bad input (a start with automatic harmonics, what the model or basis refuses) and a solve
 /// that fails outright; a solve that ends unconverged is a result, marked.
 pub fn solve(scene: &Scene, settings: &SolveSettings) -> Result<SolveAnalysis> {
+    scene.require_operating_point("solve")?;
     if let Some((q, label)) = &settings.start {
         check_start(scene, q, label)?;
     }

@@ -185,6 +185,7 @@ pub fn check_sweep(scene: &Scene, settings: &SweepSettings) -> Result<()> {
 
 /// The options of `settings` checked against `scene`, the first speed and the notes on them.
 fn plan(scene: &Scene, settings: &SweepSettings) -> Result<Plan> {
+    scene.require_operating_point("sweep")?;
     let shown = shown_output(scene, settings.output.as_deref())?;
     let reported = reported_dofs(&scene.model, settings.dofs.as_deref())?;
     let per = scene.omega_per_speed;

@@ -7,7 +7,16 @@ use std::path::Path;
 pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
     let scene = load(path, &super::SolverArgs::default())?;
     hbal::analysis::check(&scene).map_err(|e| super::failure(e, &scene.file))?;
-    say!(
+    if !scene.operating_point {
+        say!(
+            "{}: ok ({} DOF(s), {} element(s); no operating point: without `fundamental` and \
+             `harmonics` the scene is for hbal modes and check)",
+            scene.file,
+            scene.model.n_dofs(),
+            scene.model.elements().len(),
+        );
+    } else {
+        say!(
         "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s (order {} of the {} speed), H = {}, \
          N = {}, solver {})",
         scene.file,
@@ -19,7 +28,8 @@ pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
         scene.basis.harmonics(),
         scene.basis.samples(),
         scene.method.name()
-    );
+        );
+    }
     if let Some(nf) = hbal::analysis::linear_frequencies(&scene) {
         say!("  {}", frequencies(&nf));
     }

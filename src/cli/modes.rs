@@ -77,7 +77,8 @@ fn table(a: &ModesAnalysis, nf: &NaturalFrequencies) {
     } else {
         format!(
             "linearised on the orbit at {} {}",
-            a.operating_speed, a.unit
+            a.operating_speed.unwrap_or(f64::NAN),
+            a.unit
         )
     };
     say!(

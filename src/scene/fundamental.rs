@@ -37,6 +37,16 @@ pub(super) struct Speed {
 }
 
 impl Fundamental {
+    /// The stand-in of a scene without an operating point: 1000 rpm.
+    pub(super) fn placeholder() -> Self {
+        Self {
+            rpm: Some(1000.0),
+            hz: None,
+            rad_s: None,
+            order: None,
+        }
+    }
+
     /// Ω and the fundamental's order, given the engine table and the raw element tables.
     pub(super) fn speed(
         &self,

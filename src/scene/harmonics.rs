@@ -30,6 +30,19 @@ fn fail(path: &str, message: String) -> (String, String) {
 impl Harmonics {
     /// The harmonic basis at Ω = `omega` and, with `auto = true`, the automatic-harmonics
     /// settings; every error names its field.
+    /// The stand-in of a scene without an operating point: `count` harmonics.
+    pub(super) fn placeholder(count: usize) -> Self {
+        Self {
+            count: Some(count),
+            samples: None,
+            auto: false,
+            tolerance: None,
+            max: None,
+            control: None,
+            tail_correction: None,
+        }
+    }
+
     pub(super) fn basis(
         &self,
         omega: f64,

@@ -99,8 +99,11 @@ struct SceneFile {
     /// Hysteretic damping H (`+ i H` at every harmonic k >= 1), as `damping`.
     #[serde(default)]
     hysteretic_damping: Option<Value>,
-    fundamental: fundamental::Fundamental,
-    harmonics: harmonics::Harmonics,
+    /// With `harmonics`, the operating point; both may be left out for `modes` and `check`.
+    #[serde(default)]
+    fundamental: Option<fundamental::Fundamental>,
+    #[serde(default)]
+    harmonics: Option<harmonics::Harmonics>,
     /// Piston-engine excitation per order and cylinder.
     #[serde(default)]
     engine: Option<crate::model::EngineExcitation>,
@@ -136,6 +139,11 @@ pub struct Scene {
     /// The fundamental's order relative to the scene's speed (`fundamental.order`, or chosen
     /// from the engine and mesh orders: 0.5 with half orders).
     pub fundamental_order: f64,
+    /// `true` if the scene gives `fundamental` and `harmonics`: an operating point that
+    /// `solve`, `sweep`, `compare` and `report` need. Without it `basis` is a placeholder
+    /// (1000 rpm, H = the highest load or mesh order) and only `modes` of a model linear in
+    /// the state and `check` run ([`Scene::require_operating_point`]).
+    pub operating_point: bool,
     /// Things the user should know that are not errors (a `loads` order that counts half
     /// orders because the engine table chose the fundamental).
     pub notes: Vec<String>,
@@ -266,8 +274,16 @@ impl SceneFile {
         let known: std::collections::HashSet<&str> =
             dofs.names.iter().map(String::as_str).collect();
         let builder = structure.builder();
-        let speed = self
+        let operating_point = match (&self.fundamental, &self.harmonics) {
+            (Some(_), Some(_)) => true,
+            (None, None) => false,
+            (Some(_), None) => return Err(err("harmonics", "is missing: an operating point needs `fundamental` and `harmonics` (leave both out for `hbal modes` and `hbal check` of a linear model)".into())),
+            (None, Some(_)) => return Err(err("fundamental", "is missing: an operating point needs `fundamental` and `harmonics` (leave both out for `hbal modes` and `hbal check` of a linear model)".into())),
+        };
+        let fundamental = self
             .fundamental
+            .unwrap_or_else(fundamental::Fundamental::placeholder);
+        let speed = fundamental
             .speed(self.engine.as_ref(), &self.elements)
             .map_err(|(path, message)| err(&path, message))?;
         let builder = loads::add(
@@ -296,8 +312,10 @@ impl SceneFile {
                 2.0 * speed.order
             ));
         }
-        let (basis, auto) = self
+        let harmonics = self
             .harmonics
+            .unwrap_or_else(|| harmonics::Harmonics::placeholder(model.max_order().max(1)));
+        let (basis, auto) = harmonics
             .basis(speed.omega)
             .map_err(|(path, message)| err(&path, message))?;
         let method = self
@@ -314,8 +332,23 @@ impl SceneFile {
             speed_unit: speed.unit,
             omega_per_speed: speed.per_unit * speed.order,
             fundamental_order: speed.order,
+            operating_point,
             notes,
             solver: self.solver,
+        })
+    }
+}
+
+impl Scene {
+    /// An error for `analysis` (`solve`, `sweep`, ...) where the scene gives no operating
+    /// point (`fundamental` and `harmonics`).
+    pub fn require_operating_point(&self, analysis: &str) -> crate::Result<()> {
+        if self.operating_point {
+            return Ok(());
+        }
+        Err(crate::Error::InvalidElement {
+            context: format!("`{analysis}`"),
+            reason: "needs the scene's operating point: give `fundamental` and `harmonics` (hbal modes of a linear model and hbal check need none)".into(),
         })
     }
 }

@@ -58,6 +58,7 @@ mod matrix_import_bad_input;
 mod modes;
 mod new_laws;
 mod nlvib_03;
+mod no_operating_point;
 mod options_contract;
 mod order_cuts;
 mod piecewise_exact;
