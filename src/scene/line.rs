@@ -32,6 +32,10 @@ struct Line {
     disks: Vec<Disk>,
     #[serde(default)]
     shafts: Vec<Shaft>,
+    /// Couplings: a stiffness and damping between two disks (a shaft without geometry, and
+    /// without the line's `loss_factor` unless its own).
+    #[serde(default)]
+    couplings: Vec<Coupling>,
     /// Rigid gear pairs, each removing one angle (see `line_gears.rs`).
     #[serde(default)]
     gears: Vec<super::line_gears::RigidGear>,
@@ -52,6 +56,19 @@ struct Disk {
     inertia: f64,
     #[serde(default)]
     damping: f64,
+}
+
+/// One coupling between two disks.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Coupling {
+    from: String,
+    to: String,
+    stiffness: f64,
+    #[serde(default)]
+    damping: f64,
+    #[serde(default)]
+    loss_factor: f64,
 }
 
 /// One shaft or coupling between two disks: its stiffness, or its geometry.
@@ -138,8 +155,34 @@ pub(super) fn expand(doc: &mut Value) -> Result<Vec<Removed>, (String, String)> 
             damping.push(json!([r + 1, r + 1, disk.damping * f * f]));
         }
     }
-    for (s, shaft) in line.shafts.iter().enumerate() {
-        let at_field = |field: &str| format!("line.shafts[{s}].{field}");
+    let couplings: Vec<Shaft> = line
+        .couplings
+        .iter()
+        .map(|c| Shaft {
+            from: c.from.clone(),
+            to: c.to.clone(),
+            stiffness: Some(c.stiffness),
+            damping: c.damping,
+            loss_factor: Some(c.loss_factor),
+            length: None,
+            outer_diameter: None,
+            inner_diameter: None,
+            shear_modulus: None,
+        })
+        .collect();
+    let joints = (line
+        .shafts
+        .iter()
+        .enumerate()
+        .map(|(s, x)| ("shafts", s, x)))
+    .chain(
+        couplings
+            .iter()
+            .enumerate()
+            .map(|(s, x)| ("couplings", s, x)),
+    );
+    for (table, s, shaft) in joints {
+        let at_field = |field: &str| format!("line.{table}[{s}].{field}");
         let (f, t) = (
             index(at_field("from"), &shaft.from)?,
             index(at_field("to"), &shaft.to)?,

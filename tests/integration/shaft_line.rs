@@ -206,3 +206,27 @@ fn bad_lines_name_the_table_and_field() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A coupling is a stiffness and damping between two disks: the same model as a shaft with
+/// them; its bad input is named in `couplings`.
+#[test]
+fn a_coupling_is_a_shaft_without_geometry() {
+    let shaft = Scene::from_str(&format!("{SPEED}{LINE}"), "shaft.toml").unwrap();
+    let text = format!("{SPEED}{LINE}").replace(
+        "  { from = \"engine\", to = \"flywheel\", stiffness = 2e5, damping = 4.0 },\n",
+        "",
+    ) + "couplings = [{ from = \"engine\", to = \"flywheel\", stiffness = 2e5, damping = 4.0 }]\n";
+    let coupling = Scene::from_str(&text, "coupling.toml").unwrap();
+    let (a, b) = (
+        shaft.model.dense("test").unwrap(),
+        coupling.model.dense("test").unwrap(),
+    );
+    assert_eq!(a.stiffness, b.stiffness);
+    assert_eq!(a.damping, b.damping);
+    let bad = text.replace("stiffness = 2e5, damping = 4.0 }]", "stiffness = -2e5 }]");
+    let err = Scene::from_str(&bad, "bad.toml").unwrap_err().to_string();
+    assert!(
+        err.contains("line.couplings[0].stiffness: must be finite and > 0"),
+        "{err}"
+    );
+}
