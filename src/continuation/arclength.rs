@@ -303,6 +303,15 @@ impl Continuation {
                 left_parent |= share > 1e-6;
                 back
             });
+            // Past a table over speed (its loads held at its ends there) the branch stops: its
+            // points would follow loads nobody gave.
+            if let Err(e) = model.check_load_speeds(o_new, o_new) {
+                let reason = e.to_string();
+                return Some(BranchStop::Failed {
+                    parameter: o_new,
+                    reason,
+                });
+            }
             // Rescale x to the new point's size, keeping the tangent's direction.
             let sx_new = tr.rms(&x_new);
             for v in t[..m].iter_mut() {
@@ -319,6 +328,12 @@ impl Continuation {
                     let reason = e.to_string();
                     return Some(BranchStop::StabilityFailed { omega, reason });
                 }
+            }
+            // Loads that follow the speed: residuals relative to this point's load.
+            if model.has_speed_dependent_loads() {
+                let ext = tr.load_norm();
+                rel *= tr.sc.ext / ext;
+                tr.sc.ext = ext;
             }
             let failed = match new_point(model, &tr.hb, &x, omega, rel) {
                 Ok(point) => {

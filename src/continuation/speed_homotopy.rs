@@ -87,7 +87,16 @@ pub fn solve_robustly(
         max_points: continuation.max_points.min(HOMOTOPY_POINTS),
         ..continuation.clone()
     };
+    let (lo, hi) = model.load_speed_range();
+    let mut tried: Vec<f64> = Vec::new();
     for factor in [0.5, 2.0, 0.25, 4.0] {
+        // A start outside a table over speed starts at the table's end instead.
+        let start = (omega * factor).clamp(lo, hi);
+        let factor = start / omega;
+        if (factor - 1.0).abs() < 1e-3 || tried.contains(&start) {
+            continue;
+        }
+        tried.push(start);
         let far = HarmonicBasis::new(omega * factor, basis.harmonics())?
             .with_tail_correction_of(&basis)
             .with_samples(basis.samples())?;

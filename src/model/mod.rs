@@ -260,6 +260,18 @@ impl Model {
         self.loads.iter().any(|l| l.speed.is_some())
     }
 
+    /// The fundamental's speeds Ω (rad/s) where every load's speed law is defined: `(0, ∞)`
+    /// without tables over speed.
+    pub fn load_speed_range(&self) -> (f64, f64) {
+        self.loads
+            .iter()
+            .filter_map(|l| l.speed.as_deref())
+            .map(|law| law.range())
+            .fold((0.0, f64::INFINITY), |(a, b), (lo, hi)| {
+                (a.max(lo), b.min(hi))
+            })
+    }
+
     /// An error naming the first load whose speed law is not defined over the speeds `lo`
     /// to `hi` (rad/s): a table over speed is never extrapolated.
     pub fn check_load_speeds(&self, lo: f64, hi: f64) -> Result<()> {

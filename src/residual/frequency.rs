@@ -144,9 +144,10 @@ impl HarmonicBalance<'_> {
     /// sweeps. Errors as [`HarmonicBalance::new`] on a singular `Z_k`.
     pub fn set_omega(&mut self, omega: f64) -> Result<()> {
         let basis = self.basis.with_omega(omega)?;
+        let loads = self.speed_loads_at(omega)?;
         if self.condensed.is_some() {
             self.basis = basis;
-            self.refresh_speed_loads()?;
+            self.install_speed_loads(loads);
             self.condense()?;
             self.refit_tail();
             return Ok(());
@@ -161,7 +162,7 @@ impl HarmonicBalance<'_> {
             None => DynamicStiffness::of_model(&basis, dense, None)?,
         };
         self.basis = basis;
-        self.refresh_speed_loads()?;
+        self.install_speed_loads(loads);
         self.refit_tail();
         Ok(())
     }

@@ -10,6 +10,9 @@ use crate::error::Result;
 use crate::harmonic::from_cos_sin;
 use num_complex::Complex64;
 
+/// `F_ext` and `F_split` of the full model at one speed.
+pub(super) type SpeedLoads = (Vec<Complex64>, Vec<Complex64>);
+
 impl HarmonicBalance<'_> {
     /// `F_ext` and `F_split` of the full model at speed Ω (harmonic-major, `(H+1)` times the
     /// model's DOFs), the alternating part scaled by the load factor; `derivative` gives
@@ -40,29 +43,35 @@ impl HarmonicBalance<'_> {
         (f, split)
     }
 
-    /// Builds the loads again at the basis' Ω where some follow the speed (after a change of
-    /// Ω, before the condensation is refreshed); checks the static balance of a model that
-    /// floats free against the new mean load.
-    pub(super) fn refresh_speed_loads(&mut self) -> Result<()> {
+    /// The loads at Ω where some follow the speed (`None` where none does), with the static
+    /// balance of a model that floats free checked against the new mean load; a table over
+    /// speed is held at its ends outside its speeds (the continuation stops a branch that
+    /// leaves it, and every analysis checks its range first). Nothing changes on an error.
+    pub(super) fn speed_loads_at(&self, omega: f64) -> Result<Option<SpeedLoads>> {
         if !self.model.has_speed_dependent_loads() {
-            return Ok(());
+            return Ok(None);
         }
-        let omega = self.basis.omega();
-        self.model.check_load_speeds(omega, omega)?;
         let (f_ext, f_split) = self.full_loads(omega, false);
         if let Some(rigid) = &self.rigid {
             let mean: Vec<f64> = f_ext[..self.model.n_dofs()].iter().map(|v| v.re).collect();
             rigid.check_balance(self.model, &mean)?;
         }
+        Ok(Some((f_ext, f_split)))
+    }
+
+    /// Installs loads from [`speed_loads_at`](Self::speed_loads_at) (before the condensation
+    /// is refreshed, which recovers the condensed load from the full one).
+    pub(super) fn install_speed_loads(&mut self, loads: Option<SpeedLoads>) {
+        let Some((f_ext, f_split)) = loads else {
+            return;
+        };
         match self.condensed.as_mut() {
-            // `condense` recovers the condensed load from the full one.
             Some(b) => b.1 = f_split,
             None => {
                 self.f_ext = f_ext;
                 self.f_split = f_split;
             }
         }
-        Ok(())
     }
 
     /// `rhs -= ∂(load term)/∂Ω` (module documentation); nothing for loads constant over

@@ -103,10 +103,11 @@ pub fn write_scene(model: &Model, settings: &SceneSettings, path: &Path) -> Resu
     }
     let dofs = dir.join("dofs.txt");
     std::fs::write(&dofs, listing).map_err(|e| fail(&dofs, &e))?;
-    let matrices: [(&str, &SparseMatrix); 3] = [
+    let matrices: [(&str, &SparseMatrix); 4] = [
         ("mass", model.mass()),
         ("damping", model.structural_damping()),
         ("stiffness", model.structural_stiffness()),
+        ("hysteretic_damping", model.hysteretic()),
     ];
     let mut doc = Map::new();
     doc.insert("description".into(), json!(settings.description));

@@ -231,6 +231,14 @@ pub(super) fn expand(doc: &mut Value) -> Result<Vec<Removed>, (String, String)> 
         .map(|i| (names[i].clone(), names[joins[i].0].clone(), joins[i].1))
         .collect();
     let names: Vec<&String> = kept.iter().map(|&k| &names[k]).collect();
+    if let (Some(_), Some(Value::Array(elements))) = (&line.modal_damping, map.get("elements")) {
+        if !elements.is_empty() {
+            return Err((
+                "line.modal_damping".into(),
+                format!("is built from the line's disks, shafts and rigid gears, and the scene has {} element(s) that change its modes: give the shafts' `damping` (or `loss_factor`) instead, or rigid `gears` for the gear stages", elements.len()),
+            ));
+        }
+    }
     if let Some(ratios) = &line.modal_damping {
         let n = kept.len();
         let mass = nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_vec(inertia.clone()));

@@ -144,6 +144,7 @@ impl TimeSimulation {
     pub fn run(&self, model: &Model, omega: f64) -> Result<TimeResponse> {
         self.validate()?;
         model.refuse_hysteretic("time simulation")?;
+        model.check_load_speeds(omega, omega)?;
         crate::error::check_positive("time simulation", "omega", omega)?;
         let n = model.n_dofs();
         let period = TAU / omega;

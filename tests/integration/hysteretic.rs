@@ -169,3 +169,34 @@ fn a_loss_factor_is_the_hysteretic_matrix_written_by_hand() {
     );
     assert!(line.model.has_hysteretic_damping());
 }
+
+/// A scene written back (`write_scene`) keeps its hysteretic damping: the same H, the same
+/// solution.
+#[test]
+fn written_scenes_keep_the_hysteretic_damping() {
+    use hbal::scene::export::{write_scene, SceneSettings};
+    let scene = hbal::scene::Scene::from_str(SCENE, "line.toml").unwrap();
+    let dir = crate::common::cli::temp_dir("hysteretic-export");
+    let file = dir.join("line.toml");
+    write_scene(
+        &scene.model,
+        &SceneSettings::new("line", "rpm", 600.0, 4),
+        &file,
+    )
+    .unwrap();
+    let back = hbal::scene::Scene::load(&file).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(
+        back.model.hysteretic().to_dense(),
+        scene.model.hysteretic().to_dense()
+    );
+    let solve = |s: &hbal::scene::Scene| {
+        let hb = HarmonicBalance::new(&s.model, s.basis).unwrap();
+        Newton::new()
+            .solve(&hb, &mut hb.workspace())
+            .unwrap()
+            .harmonics()
+            .to_vec()
+    };
+    assert_eq!(solve(&scene), solve(&back));
+}

@@ -218,6 +218,12 @@ fn bad_gears_and_modal_damping_are_named() {
             "line.modal_damping",
             "2 elastic modes",
         ),
+        (
+            "modal_damping = 0.02\n[[elements]]\nname = \"s\"\ntype = \"linear_spring\"\nconnects = { motor = 1.0 }\nk = 1.0\n",
+            ("", ""),
+            "line.modal_damping",
+            "1 element(s) that change its modes",
+        ),
     ] {
         let text = format!("{HEAD}{}{extra}", LINE.replace(replace.0, replace.1));
         let text = if replace.0.is_empty() {

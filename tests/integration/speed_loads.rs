@@ -152,8 +152,30 @@ fn a_speed_outside_the_table_is_refused() {
         "{msg}"
     );
     assert_eq!(err.exit_code(), 2);
-    let mut hb = HarmonicBalance::new(&model, HarmonicBasis::new(39.0 * RPM, 5).unwrap()).unwrap();
-    let err = hb.set_omega(41.0 * RPM).unwrap_err();
+    // A sweep of the nonlinear model reaches the table's last speed exactly (its predictor
+    // may look past it), and a branch that leaves the table stops there with the table's
+    // message, its points all inside.
+    let basis = HarmonicBasis::new(30.0 * RPM, 5).unwrap();
+    let to_end = Continuation::default()
+        .run(&model, basis, 40.0 * RPM, |_| {})
+        .unwrap();
+    assert_eq!(to_end.stop, hbal::continuation::BranchStop::Reached);
+    assert!((to_end.points.last().unwrap().omega - 40.0 * RPM).abs() < 1e-12);
+    let beyond = Continuation::default()
+        .run(&model, basis, 45.0 * RPM, |_| {})
+        .unwrap();
+    let hbal::continuation::BranchStop::Failed { reason, .. } = &beyond.stop else {
+        panic!("{:?}", beyond.stop);
+    };
+    assert!(reason.contains("never extrapolated"), "{reason}");
+    assert!(beyond
+        .points
+        .iter()
+        .all(|p| p.omega <= 40.0 * RPM * (1.0 + 1e-12)));
+    // The time integration and the Floquet analysis refuse a speed outside it too.
+    let err = hbal::timesim::TimeSimulation::new()
+        .run(&model, 41.0 * RPM)
+        .unwrap_err();
     assert!(err.to_string().contains("never extrapolated"), "{err}");
 }
 

@@ -61,6 +61,8 @@ impl FloquetOptions {
             ));
         }
         model.refuse_hysteretic("floquet")?;
+        let omega = solution.basis().omega();
+        model.check_load_speeds(omega, omega)?;
         // The variational equation of a law with memory is not the one of `(∂f/∂u, ∂f/∂u̇)`:
         // shooting on the time-domain model with the laws' states instead.
         if model.memory_element().is_some() {
