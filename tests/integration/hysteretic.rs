@@ -139,14 +139,7 @@ fn front_ends_say_what_hysteretic_damping_rules_out() {
             "`hysteretic_damping`",
         ),
     ] {
-        let bad = write("bad.toml", &text);
-        let out = crate::common::hbal(&["check", &bad]);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{path}: {err}");
-        assert!(
-            err.contains(&format!("{path}:")) && err.contains(words),
-            "{path}: {err}"
-        );
+        crate::common::cli::check_refuses(&dir, &text, path, words);
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -84,26 +84,9 @@ fn omega_derivative_includes_the_loads() {
         let omega = 22.5 * RPM;
         let basis = HarmonicBasis::new(omega, 5).unwrap();
         let mut hb = HarmonicBalance::with_formulation(&model, basis, formulation).unwrap();
-        let mut ws = hb.workspace();
         let m = hb.layout().len();
         let x: Vec<f64> = (0..m).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
-        let mut dr = vec![0.0; m];
-        hb.omega_derivative_real_into(&x, &mut dr, &mut ws).unwrap();
-        let step = 1e-6;
-        let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
-        hb.set_omega(omega + step).unwrap();
-        hb.residual_real_into(&x, &mut rp, None, &mut ws).unwrap();
-        hb.set_omega(omega - step).unwrap();
-        hb.residual_real_into(&x, &mut rm, None, &mut ws).unwrap();
-        let scale = dr.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        for i in 0..m {
-            let fd = (rp[i] - rm[i]) / (2.0 * step);
-            assert!(
-                (fd - dr[i]).abs() < 1e-6 * scale,
-                "{formulation:?} entry {i}: {fd} vs {}",
-                dr[i]
-            );
-        }
+        crate::common::assert_omega_derivative(&mut hb, &x, &format!("{formulation:?}"));
     }
 }
 
@@ -308,14 +291,7 @@ fn sweeps_within_the_table_run_and_bad_tables_are_refused() {
             "> 0",
         ),
     ] {
-        let bad = write("bad.toml", &text);
-        let out = crate::common::hbal(&["check", &bad]);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{path}: {err}");
-        assert!(
-            err.contains(&format!("{path}:")) && err.contains(words),
-            "{path}: {err}"
-        );
+        crate::common::cli::check_refuses(&dir, &text, path, words);
     }
     std::fs::remove_dir_all(&dir).ok();
 }

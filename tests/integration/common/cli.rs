@@ -35,3 +35,17 @@ pub fn backlash_at_08(dir: &Path) -> PathBuf {
     std::fs::write(&path, text.replace("rad_s = 0.7", "rad_s = 0.8")).unwrap();
     path
 }
+
+/// `hbal check` of `text` (written to `dir/bad.toml`) fails with exit code 2 and a message
+/// that names the field `path` (`path:`) and says `words`.
+pub fn check_refuses(dir: &Path, text: &str, path: &str, words: &str) {
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, text).unwrap();
+    let out = super::hbal(&["check", &bad.to_string_lossy()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{path}: {err}");
+    assert!(
+        err.contains(&format!("{path}:")) && err.contains(words),
+        "{path}: {err}"
+    );
+}

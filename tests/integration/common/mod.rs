@@ -72,3 +72,28 @@ pub fn jacobian_against_differences(
     }
     (worst, jac.amax())
 }
+
+/// `∂R/∂Ω` of `hb` at `x` against central differences of the residual in Ω (step 1e-6):
+/// every entry within 1e-6 of the largest.
+pub fn assert_omega_derivative(hb: &mut hbal::HarmonicBalance, x: &[f64], label: &str) {
+    let omega = hb.basis().omega();
+    let mut ws = hb.workspace();
+    let m = x.len();
+    let mut dr = vec![0.0; m];
+    hb.omega_derivative_real_into(x, &mut dr, &mut ws).unwrap();
+    let step = 1e-6;
+    let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
+    hb.set_omega(omega + step).unwrap();
+    hb.residual_real_into(x, &mut rp, None, &mut ws).unwrap();
+    hb.set_omega(omega - step).unwrap();
+    hb.residual_real_into(x, &mut rm, None, &mut ws).unwrap();
+    let scale = dr.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for i in 0..m {
+        let fd = (rp[i] - rm[i]) / (2.0 * step);
+        assert!(
+            (fd - dr[i]).abs() < 1e-6 * scale,
+            "{label} entry {i}: {fd} vs {}",
+            dr[i]
+        );
+    }
+}
