@@ -14,10 +14,9 @@ use num_complex::Complex64;
 pub(super) type SpeedLoads = (Vec<Complex64>, Vec<Complex64>);
 
 impl HarmonicBalance<'_> {
-    /// `F_ext` and `F_split` of the full model at speed Ω (harmonic-major, `(H+1)` times the
-    /// model's DOFs), the alternating part scaled by the load factor; `derivative` gives
-    /// `∂F/∂Ω` instead (no offsets).
-    fn full_loads(&self, omega: f64, derivative: bool) -> (Vec<Complex64>, Vec<Complex64>) {
+    /// `F_ext` of the full model at speed Ω (harmonic-major, `(H+1)` times the model's DOFs),
+    /// the alternating part scaled by the load factor; `derivative` gives `∂F/∂Ω` instead.
+    fn full_loads(&self, omega: f64, derivative: bool) -> Vec<Complex64> {
         let n = self.model.n_dofs();
         let h = self.basis.harmonics();
         let nu = self.basis.subharmonic();
@@ -31,16 +30,7 @@ impl HarmonicBalance<'_> {
             let scale = if l.order == 0 { 1.0 } else { self.load_factor };
             f[l.order * nu * n + l.dof] += from_cos_sin(c, s) * scale;
         }
-        let mut split = f.clone();
-        if !derivative {
-            for e in self.model.elements() {
-                e.scatter_add(
-                    Complex64::new(-e.linear_part().offset, 0.0),
-                    &mut split[..n],
-                );
-            }
-        }
-        (f, split)
+        f
     }
 
     /// The loads at Ω where some follow the speed (`None` where none does), with the static
@@ -51,7 +41,14 @@ impl HarmonicBalance<'_> {
         if !self.model.has_speed_dependent_loads() {
             return Ok(None);
         }
-        let (f_ext, f_split) = self.full_loads(omega, false);
+        let f_ext = self.full_loads(omega, false);
+        let mut f_split = f_ext.clone();
+        for e in self.model.elements() {
+            e.scatter_add(
+                Complex64::new(-e.linear_part().offset, 0.0),
+                &mut f_split[..self.model.n_dofs()],
+            );
+        }
         if let Some(rigid) = &self.rigid {
             let mean: Vec<f64> = f_ext[..self.model.n_dofs()].iter().map(|v| v.re).collect();
             rigid.check_balance(self.model, &mean)?;
@@ -80,7 +77,7 @@ impl HarmonicBalance<'_> {
         if !self.model.has_speed_dependent_loads() {
             return;
         }
-        let (df, _) = self.full_loads(self.basis.omega(), true);
+        let df = self.full_loads(self.basis.omega(), true);
         let Some(b) = self.condensed.as_deref() else {
             for (r, d) in rhs.iter_mut().zip(&df) {
                 *r -= d;

@@ -36,10 +36,7 @@ pub(super) fn engine_error(e: crate::Error) -> (String, String) {
         // The path already says `engine`; a field named first in the reason (or a speed law's
         // context, `engine orders[2].speed`) makes it precise.
         crate::Error::InvalidElement { context, reason } => {
-            let field = reason
-                .strip_prefix('`')
-                .and_then(|m| m.split('`').next())
-                .filter(|f| !f.contains(' '));
+            let field = leading_field(reason).filter(|f| !f.contains(' '));
             let within = context
                 .strip_prefix("engine ")
                 .filter(|c| c.starts_with("orders["));
@@ -55,16 +52,19 @@ pub(super) fn engine_error(e: crate::Error) -> (String, String) {
     }
 }
 
+/// The field a library message names first, in backticks (`` `rpm` must be ... ``).
+fn leading_field(message: &str) -> Option<&str> {
+    message.strip_prefix('`').and_then(|m| m.split('`').next())
+}
+
 /// A speed law's error at `path` (`loads[2].speed.rpm`), from the field its message names.
 fn speed_error(path: &str, e: crate::Error) -> (String, String) {
     let message = match &e {
         crate::Error::InvalidElement { reason, .. } => reason.clone(),
         _ => e.to_string(),
     };
-    let field = message
-        .strip_prefix('`')
-        .and_then(|m| m.split('`').next())
-        .filter(|f| ["exponent", "rpm", "amplitude", "phase"].contains(f));
+    let field =
+        leading_field(&message).filter(|f| ["exponent", "rpm", "amplitude", "phase"].contains(f));
     match field {
         Some(f) => fail(&format!("{path}.{f}"), message),
         None => fail(path, message),
