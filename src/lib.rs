@@ -69,6 +69,7 @@ pub mod solution;
 pub mod solve;
 pub mod stability;
 pub mod timesim;
+pub mod torus;
 
 pub use error::{Error, Result};
 pub use harmonic::HarmonicBasis;

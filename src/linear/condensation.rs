@@ -365,7 +365,7 @@ impl Condensation {
 }
 
 /// `Some(s)` if `a = s b` (same DOFs, proportional weights to 1e-12), else `None`.
-fn parallel(a: &[(usize, f64)], b: &[(usize, f64)]) -> Option<f64> {
+pub(crate) fn parallel(a: &[(usize, f64)], b: &[(usize, f64)]) -> Option<f64> {
     let nz = |v: &[(usize, f64)]| -> Vec<(usize, f64)> {
         let mut v: Vec<_> = v.iter().copied().filter(|(_, w)| *w != 0.0).collect();
         v.sort_by_key(|(i, _)| *i);

@@ -80,4 +80,5 @@ mod stability_weak_ground;
 mod stability_worker;
 mod tail_correction;
 mod threads;
+mod torus;
 mod two_level;

@@ -1,0 +1,553 @@
+//! The harmonic balance on the torus, condensed onto the element coordinates:
+//!
+//! `R_j(U) = G_j⁻¹ U_j + N_j(U) - L_j = 0` for every line j of the index set, with the rest
+//! `N(U)` of the elements' forces by AFT on the torus grid: per coordinate c,
+//! `u_c(θ) = Re Σ_j U_{j,c} e^{i k_j·θ}` and `u̇_c = Re Σ_j i ν_j U_{j,c} e^{i k_j·θ}`
+//! (`ν_j = Ω k_j·r`), each element's `f(θ_b, s u_c, s u̇_c) - f0 - k0 u - d0 u̇` evaluated at its
+//! own base's angle, summed per coordinate (times `s`) and transformed back.
+//!
+//! The Jacobian is applied, not stored: `J v = G⁻¹ v + FFT[g_u v(θ) + g_u̇ v̇(θ)]` with the
+//! samples `g = Σ_e s² (∂f/∂u - k0)` of the last evaluation (the exact derivative of the AFT),
+//! for the Krylov solver of [`super::newton_krylov`].
+
+use super::grid::{TorusFft, TorusScratch};
+use super::linear::TorusLinear;
+use super::{IndexSet, TorusModel};
+use crate::error::{Error, Result};
+use crate::force::{ForceLaw, LinearPart};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+/// A time-varying or nonlinear element on the torus.
+#[derive(Debug, Clone)]
+struct TorusElement {
+    index: usize,
+    coordinate: usize,
+    /// `w_e = s W[:, c]`.
+    factor: f64,
+    base: usize,
+    /// The band-limited copy the AFT evaluates, where the law has one.
+    band_limited: Option<Arc<dyn ForceLaw>>,
+    /// Grid points whose angle of the element's base sits on a time jump of the law.
+    jumps: Vec<usize>,
+    linear: LinearPart,
+}
+
+/// The torus harmonic balance of a [`TorusModel`] on an index set and grid, at speed Ω.
+#[derive(Debug)]
+pub struct TorusBalance<'m> {
+    tm: TorusModel<'m>,
+    set: IndexSet,
+    fft: TorusFft,
+    omega: f64,
+    coordinates: Vec<Vec<(usize, f64)>>,
+    names: Vec<String>,
+    active: Vec<TorusElement>,
+    /// Per base, its angle at every grid point.
+    thetas: Vec<Vec<f64>>,
+    dense: crate::model::DenseMatrices,
+    augmentation: Option<DMatrix<f64>>,
+    w: DMatrix<f64>,
+    f_full: Vec<Complex64>,
+    pub(super) linear: TorusLinear,
+}
+
+/// Buffers of [`TorusBalance`]; make one with [`TorusBalance::workspace`].
+#[derive(Debug, Clone)]
+pub struct TorusWorkspace {
+    pub(super) fft: TorusScratch,
+    u: Vec<Vec<f64>>,
+    du: Vec<Vec<f64>>,
+    force: Vec<Vec<f64>>,
+    ue: Vec<f64>,
+    due: Vec<f64>,
+    fe: Vec<f64>,
+    ge: Vec<f64>,
+    gde: Vec<f64>,
+    /// `Σ_e s² (∂f/∂u - k0)`, `Σ_e s² (∂f/∂u̇ - d0)` per coordinate at the last evaluation
+    /// with derivatives.
+    pub(super) gu: Vec<Vec<f64>>,
+    pub(super) gdu: Vec<Vec<f64>>,
+    /// Transforms done.
+    pub ffts: usize,
+}
+
+impl<'m> TorusBalance<'m> {
+    /// The balance of `tm` on `set` with `samples` grid points per base at speed `omega`
+    /// (rad/s of the speed the bases' ratios refer to). Errors, before any work: a load or an
+    /// element's time variation above its base's cap, a law with memory, a grid too coarse or
+    /// too large, a singular dynamic stiffness at some line, static loads that do not balance
+    /// on a free-free model.
+    pub fn new(tm: TorusModel<'m>, set: IndexSet, samples: &[usize], omega: f64) -> Result<Self> {
+        let model = tm.model();
+        if set.dims() != tm.bases().len() {
+            return Err(Error::DimensionMismatch {
+                context: "torus index set (one cap per base)".into(),
+                expected: tm.bases().len().to_string(),
+                got: set.dims().to_string(),
+            });
+        }
+        crate::harmonic::HarmonicBasis::new(omega, 0)?;
+        model.check_load_speeds(omega, omega)?;
+        let fft = TorusFft::new(&set, samples)?;
+        let (n, d) = (model.n_dofs(), set.dims());
+        let f_full = full_load(&tm, &set, omega)?;
+        let (active, coordinates, names) = active_elements(&tm, &set, fft.dims())?;
+        let points = fft.points();
+        let thetas = (0..d)
+            .map(|b| {
+                let stride: usize = fft.dims()[b + 1..].iter().product();
+                let nb = fft.dims()[b];
+                (0..points)
+                    .map(|p| TAU * ((p / stride) % nb) as f64 / nb as f64)
+                    .collect()
+            })
+            .collect();
+        let dense = model.dense("torus harmonic balance")?;
+        let w = DMatrix::from_fn(n, coordinates.len(), |i, c| {
+            coordinates[c]
+                .iter()
+                .filter(|(k, _)| *k == i)
+                .map(|(_, v)| v)
+                .sum()
+        });
+        let mut augmentation = None;
+        let linear = match TorusLinear::new(&dense, None, &set, omega, &w, &f_full) {
+            Err(e @ Error::SingularDynamicStiffness { harmonic: 0, .. }) => {
+                let rigid = crate::model::rigid::find_dense(model, &dense).ok_or(e)?;
+                let mean: Vec<f64> = f_full[..n].iter().map(|v| v.re).collect();
+                rigid.check_balance(model, &mean)?;
+                let a = rigid.augmentation();
+                let linear = TorusLinear::new(&dense, Some(&a), &set, omega, &w, &f_full)?;
+                augmentation = Some(a);
+                linear
+            }
+            r => r?,
+        };
+        Ok(Self {
+            tm,
+            set,
+            fft,
+            omega,
+            coordinates,
+            names,
+            active,
+            thetas,
+            dense,
+            augmentation,
+            w,
+            f_full,
+            linear,
+        })
+    }
+
+    /// Moves the balance to speed `omega` (refactors every line); nothing changes on an error.
+    pub fn set_omega(&mut self, omega: f64) -> Result<()> {
+        crate::harmonic::HarmonicBasis::new(omega, 0)?;
+        self.tm.model().check_load_speeds(omega, omega)?;
+        let f_full = full_load(&self.tm, &self.set, omega)?;
+        let aug = self.augmentation.as_ref();
+        self.linear = TorusLinear::new(&self.dense, aug, &self.set, omega, &self.w, &f_full)?;
+        self.f_full = f_full;
+        self.omega = omega;
+        Ok(())
+    }
+
+    /// Buffers for this balance.
+    pub fn workspace(&self) -> TorusWorkspace {
+        let (p, m) = (self.fft.points(), self.coordinates.len());
+        let grid = || vec![0.0; p];
+        TorusWorkspace {
+            fft: self.fft.make_scratch(),
+            u: vec![grid(); m],
+            du: vec![grid(); m],
+            force: vec![grid(); m],
+            ue: grid(),
+            due: grid(),
+            fe: grid(),
+            ge: grid(),
+            gde: grid(),
+            gu: vec![grid(); m],
+            gdu: vec![grid(); m],
+            ffts: 0,
+        }
+    }
+
+    /// The speed Ω.
+    pub fn omega(&self) -> f64 {
+        self.omega
+    }
+
+    /// The index set.
+    pub fn set(&self) -> &IndexSet {
+        &self.set
+    }
+
+    /// The model on its bases.
+    pub fn torus_model(&self) -> &TorusModel<'m> {
+        &self.tm
+    }
+
+    /// The grid's samples per base.
+    pub fn samples(&self) -> &[usize] {
+        self.fft.dims()
+    }
+
+    /// Number of element coordinates m (unknowns per line).
+    pub fn coordinates(&self) -> usize {
+        self.coordinates.len()
+    }
+
+    /// The coordinates' names (`u(element)`).
+    pub fn coordinate_names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Number of complex unknowns (lines × coordinates).
+    pub fn len(&self) -> usize {
+        self.set.len() * self.coordinates.len()
+    }
+
+    /// `true` where nothing is condensed (no time-varying or nonlinear element): the
+    /// response is `Z_j⁻¹ F_j`.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The frequency `ν_j = Ω k_j·r` of line j (rad/s).
+    pub fn frequency(&self, j: usize) -> f64 {
+        self.omega * self.set.ratio(j)
+    }
+
+    /// The condensed load `L` (line-major).
+    pub fn load(&self) -> &[Complex64] {
+        &self.linear.load
+    }
+
+    /// The linear start: `U_j = G_j L_j` (the response with the rest `N = 0`).
+    pub fn linear_start(&self) -> Vec<Complex64> {
+        let m = self.coordinates();
+        let mut u = Vec::with_capacity(self.len());
+        for (j, x) in self.linear.solved.iter().enumerate() {
+            for c in 0..m {
+                u.push(
+                    self.coordinates[c]
+                        .iter()
+                        .map(|&(i, w)| x[(i, m)] * w)
+                        .sum(),
+                );
+            }
+            let _ = j;
+        }
+        u
+    }
+
+    /// `out ← R(U) = G⁻¹ U + N(U) - L`; with `derivatives`, the samples the Jacobian needs
+    /// are kept in `ws`.
+    pub fn residual_into(
+        &self,
+        u: &[Complex64],
+        out: &mut [Complex64],
+        derivatives: bool,
+        ws: &mut TorusWorkspace,
+    ) -> Result<()> {
+        self.rest_into(u, out, derivatives, ws)?;
+        let m = self.coordinates();
+        let mut lin = vec![Complex64::default(); m];
+        for (j, g) in self.linear.stiffness.iter().enumerate() {
+            for (a, l) in lin.iter_mut().enumerate() {
+                *l = (0..m).map(|b| g[(a, b)] * u[j * m + b]).sum();
+            }
+            for c in 0..m {
+                out[j * m + c] += lin[c] - self.linear.load[j * m + c];
+            }
+        }
+        Ok(())
+    }
+
+    /// `out ← N(U)`, the rest of the elements' forces per line and coordinate.
+    pub fn rest_into(
+        &self,
+        u: &[Complex64],
+        out: &mut [Complex64],
+        derivatives: bool,
+        ws: &mut TorusWorkspace,
+    ) -> Result<()> {
+        let m = self.coordinates();
+        for c in 0..m {
+            self.synthesize(u, c, false, &mut ws.u[c], &mut ws.fft);
+            self.synthesize(u, c, true, &mut ws.du[c], &mut ws.fft);
+            ws.ffts += 2;
+            ws.force[c].fill(0.0);
+            if derivatives {
+                ws.gu[c].fill(0.0);
+                ws.gdu[c].fill(0.0);
+            }
+        }
+        for act in &self.active {
+            self.element_force(act, derivatives, ws)?;
+        }
+        out.fill(Complex64::default());
+        for c in 0..m {
+            let mut force = std::mem::take(&mut ws.force[c]);
+            self.fft
+                .analyze(&mut force, &mut ws.fft, |j, v| out[j * m + c] = v);
+            ws.force[c] = force;
+            ws.ffts += 1;
+        }
+        Ok(())
+    }
+
+    /// One element's rest into its coordinate's force samples (and derivative samples).
+    fn element_force(
+        &self,
+        act: &TorusElement,
+        derivatives: bool,
+        ws: &mut TorusWorkspace,
+    ) -> Result<()> {
+        let e = &self.tm.model().elements()[act.index];
+        let law = act.band_limited.as_deref().unwrap_or(e.law());
+        let (c, s, lin) = (act.coordinate, act.factor, act.linear);
+        let theta = &self.thetas[act.base];
+        for (x, &v) in ws.ue.iter_mut().zip(&ws.u[c]) {
+            *x = s * v;
+        }
+        for (x, &v) in ws.due.iter_mut().zip(&ws.du[c]) {
+            *x = s * v;
+        }
+        law.force_batch(theta, &ws.ue, &ws.due, &mut ws.fe);
+        let delta = 1e-7 * TAU / self.fft.dims()[act.base] as f64;
+        for &p in &act.jumps {
+            let (t, x, v) = (theta[p], ws.ue[p], ws.due[p]);
+            ws.fe[p] = 0.5 * (law.force(t - delta, x, v) + law.force(t + delta, x, v));
+        }
+        for (((f, &x), &v), acc) in ws.fe.iter().zip(&ws.ue).zip(&ws.due).zip(&mut ws.force[c]) {
+            let rest = f - lin.offset - lin.stiffness * x - lin.damping * v;
+            if !rest.is_finite() {
+                return Err(Error::NonFinite {
+                    what: format!(
+                        "the force of element `{}` on the torus grid (u = {x:e}, u̇ = {v:e})",
+                        e.name()
+                    ),
+                });
+            }
+            *acc += s * rest;
+        }
+        if derivatives {
+            law.derivatives_batch(theta, &ws.ue, &ws.due, &mut ws.ge, &mut ws.gde);
+            for &p in &act.jumps {
+                let (t, x, v) = (theta[p], ws.ue[p], ws.due[p]);
+                let (a0, b0) = law.derivatives(t - delta, x, v);
+                let (a1, b1) = law.derivatives(t + delta, x, v);
+                (ws.ge[p], ws.gde[p]) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
+            }
+            let s2 = s * s;
+            for p in 0..ws.ge.len() {
+                let (a, b) = (ws.ge[p] - lin.stiffness, ws.gde[p] - lin.damping);
+                if !(a.is_finite() && b.is_finite()) {
+                    return Err(Error::NonFinite {
+                        what: format!("the force derivatives of element `{}`", e.name()),
+                    });
+                }
+                ws.gu[c][p] += s2 * a;
+                ws.gdu[c][p] += s2 * b;
+            }
+        }
+        Ok(())
+    }
+
+    /// Samples of coordinate c of `u` (or of its time derivative) into `out`.
+    fn synthesize(
+        &self,
+        u: &[Complex64],
+        c: usize,
+        derivative: bool,
+        out: &mut [f64],
+        scratch: &mut TorusScratch,
+    ) {
+        let m = self.coordinates();
+        let omega = self.omega;
+        let set = &self.set;
+        if derivative {
+            self.fft.synthesize_into(
+                |j| u[j * m + c] * Complex64::new(0.0, omega * set.ratio(j)),
+                out,
+                scratch,
+            );
+        } else {
+            self.fft.synthesize_into(|j| u[j * m + c], out, scratch);
+        }
+    }
+
+    /// `out ← J v = G⁻¹ v + ∂N/∂U v` at the state of the last
+    /// [`residual_into`](Self::residual_into) with derivatives.
+    pub fn jacobian_apply(&self, v: &[Complex64], out: &mut [Complex64], ws: &mut TorusWorkspace) {
+        let m = self.coordinates();
+        self.linear.apply_stiffness(v, out);
+        for c in 0..m {
+            let (mut x, mut dx) = (std::mem::take(&mut ws.ue), std::mem::take(&mut ws.due));
+            self.synthesize(v, c, false, &mut x, &mut ws.fft);
+            self.synthesize(v, c, true, &mut dx, &mut ws.fft);
+            ws.ffts += 2;
+            for (p, xp) in x.iter_mut().enumerate() {
+                *xp = ws.gu[c][p] * *xp + ws.gdu[c][p] * dx[p];
+            }
+            self.fft
+                .analyze(&mut x, &mut ws.fft, |j, val| out[j * m + c] += val);
+            ws.ffts += 1;
+            (ws.ue, ws.due) = (x, dx);
+        }
+    }
+
+    /// The grid means of the derivative samples per coordinate, `(ḡ_u, ḡ_u̇)`, at the last
+    /// evaluation with derivatives: the averaged Jacobian's diagonal.
+    pub(super) fn mean_derivatives(&self, ws: &TorusWorkspace) -> Vec<(f64, f64)> {
+        let p = self.fft.points() as f64;
+        (0..self.coordinates())
+            .map(|c| {
+                (
+                    ws.gu[c].iter().sum::<f64>() / p,
+                    ws.gdu[c].iter().sum::<f64>() / p,
+                )
+            })
+            .collect()
+    }
+
+    /// The full response `Q_j` (line-major, n DOFs per line) of the unknowns `u`.
+    pub fn full_harmonics(
+        &self,
+        u: &[Complex64],
+        ws: &mut TorusWorkspace,
+    ) -> Result<Vec<Complex64>> {
+        let mut rest = vec![Complex64::default(); self.len()];
+        if !self.is_empty() {
+            self.rest_into(u, &mut rest, false, ws)?;
+        }
+        Ok(self.linear.recover(&rest))
+    }
+
+    /// The full load `F_j` (line-major, n per line), with the elements' static offsets moved
+    /// to the load side.
+    pub fn full_load(&self) -> &[Complex64] {
+        &self.f_full
+    }
+}
+
+/// `F_j` of the loads on their bases, minus `Σ w f0` at the static line.
+fn full_load(tm: &TorusModel, set: &IndexSet, omega: f64) -> Result<Vec<Complex64>> {
+    let model = tm.model();
+    let (n, d) = (model.n_dofs(), set.dims());
+    let mut f = vec![Complex64::default(); set.len() * n];
+    for (l, load) in model.loads().iter().enumerate() {
+        let b = tm.load_base(l);
+        let mut k = vec![0i32; d];
+        k[b] = i32::try_from(load.order).unwrap_or(i32::MAX);
+        let Some(j) = set.position(&k) else {
+            return Err(Error::InvalidElement {
+                context: format!(
+                    "load on `{}` order {} on base `{}`",
+                    model.dof_names()[load.dof],
+                    load.order,
+                    tm.bases().names()[b]
+                ),
+                reason: format!(
+                    "the torus keeps only {} harmonics of that base: raise its cap",
+                    set.caps()[b]
+                ),
+            });
+        };
+        let (c, s) = load.at(omega);
+        f[j * n + load.dof] += crate::harmonic::from_cos_sin(c, s);
+    }
+    for e in model.elements() {
+        e.scatter_add(Complex64::new(-e.linear_part().offset, 0.0), &mut f[..n]);
+    }
+    Ok(f)
+}
+
+/// The time-varying or nonlinear elements, their coordinates (parallel weights merged) and
+/// the coordinates' names.
+#[allow(clippy::type_complexity)]
+fn active_elements(
+    tm: &TorusModel,
+    set: &IndexSet,
+    dims: &[usize],
+) -> Result<(Vec<TorusElement>, Vec<Vec<(usize, f64)>>, Vec<String>)> {
+    let model = tm.model();
+    let mut coordinates: Vec<Vec<(usize, f64)>> = Vec::new();
+    let mut names = Vec::new();
+    let mut active = Vec::new();
+    for (index, e) in model.elements().iter().enumerate() {
+        if e.law().is_linear_time_invariant() {
+            continue;
+        }
+        let base = tm.element_base(index);
+        let (cap, nb) = (set.caps()[base], dims[base]);
+        let context = format!(
+            "element `{}` on torus base `{}`",
+            e.name(),
+            tm.bases().names()[base]
+        );
+        if e.law().memory().is_some() {
+            return Err(Error::InvalidElement {
+                context,
+                reason: "a law with memory (a friction slider) is not available on the torus yet; use the one-frequency basis".into(),
+            });
+        }
+        if let Some(order) = e.law().time_order() {
+            if order > cap {
+                return Err(Error::InvalidElement {
+                    context,
+                    reason: format!(
+                        "the law varies at order {order} of its base but only {cap} harmonics of it are kept: raise the cap or bind it to a base that turns {order} times faster"
+                    ),
+                });
+            }
+        }
+        let found = coordinates.iter().enumerate().find_map(|(c, v)| {
+            crate::linear::condensation::parallel(e.weights(), v).map(|s| (c, s))
+        });
+        let (coordinate, factor) = found.unwrap_or_else(|| {
+            coordinates.push(e.weights().to_vec());
+            names.push(format!("u({})", e.name()));
+            (coordinates.len() - 1, 1.0)
+        });
+        let band = if nb > 4 * cap {
+            2 * cap
+        } else {
+            nb.saturating_sub(2 * cap + 1).max(cap / 2)
+        };
+        let band_limited: Option<Arc<dyn ForceLaw>> =
+            e.law().band_limited(nb, band).map(Into::into);
+        let law = band_limited.as_deref().unwrap_or(e.law());
+        let on_jump: Vec<bool> = {
+            let mut marks = vec![false; nb];
+            for b in law.time_breakpoints() {
+                let x = b.rem_euclid(TAU) / TAU * nb as f64;
+                if (x - x.round()).abs() < 1e-9 {
+                    marks[x.round() as usize % nb] = true;
+                }
+            }
+            marks
+        };
+        let stride: usize = dims[base + 1..].iter().product();
+        let points: usize = dims.iter().product();
+        let jumps = if on_jump.iter().any(|&j| j) {
+            (0..points).filter(|p| on_jump[(p / stride) % nb]).collect()
+        } else {
+            Vec::new()
+        };
+        active.push(TorusElement {
+            index,
+            coordinate,
+            factor,
+            base,
+            band_limited,
+            jumps,
+            linear: e.linear_part(),
+        });
+    }
+    Ok((active, coordinates, names))
+}

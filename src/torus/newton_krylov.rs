@@ -1,0 +1,190 @@
+//! Newton's method on the condensed torus balance with the Jacobian applied by AFT and the
+//! steps solved by GMRES, preconditioned by the averaged Jacobian
+//! `P_j = G_j⁻¹ + diag_c(ḡ_u + i ν_j ḡ_u̇)`: block diagonal over the lines (m × m each), it
+//! is the exact Jacobian where the elements' derivatives are constant on the grid, and
+//! cheap to factor where the dense Jacobian (`(2 |K| m)²` entries) would not be.
+
+use super::balance::{TorusBalance, TorusWorkspace};
+use super::gmres::gmres;
+use super::TorusSolution;
+use crate::error::Result;
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+/// Newton–Krylov settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonKrylov {
+    /// Converged at `‖R‖ <= tolerance · max(‖L‖, ‖G⁻¹ U‖)`.
+    pub tolerance: f64,
+    /// Most Newton steps.
+    pub max_iterations: usize,
+    /// Relative tolerance of each step's linear solve.
+    pub forcing: f64,
+    /// GMRES restart length.
+    pub restart: usize,
+    /// Most Jacobian products per step.
+    pub max_linear: usize,
+}
+
+impl Default for NewtonKrylov {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-10,
+            max_iterations: 40,
+            forcing: 1e-3,
+            restart: 40,
+            max_linear: 400,
+        }
+    }
+}
+
+fn norm(x: &[Complex64]) -> f64 {
+    x.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt()
+}
+
+impl NewtonKrylov {
+    /// Solves `hb` from `start` (the linear response where `None`). A step that does not
+    /// lower the residual after 12 halvings ends the run, marked not converged.
+    pub fn solve(&self, hb: &TorusBalance, start: Option<&[Complex64]>) -> Result<TorusSolution> {
+        let mut ws = hb.workspace();
+        let mut u = start.map_or_else(|| hb.linear_start(), <[Complex64]>::to_vec);
+        let len = hb.len();
+        let (mut iterations, mut linear) = (0, 0);
+        let mut r = vec![Complex64::default(); len];
+        let mut relative = 0.0;
+        let mut converged = len == 0;
+        if len > 0 {
+            hb.residual_into(&u, &mut r, true, &mut ws)?;
+            let mut trial = vec![Complex64::default(); len];
+            let mut r_trial = vec![Complex64::default(); len];
+            let mut step = vec![Complex64::default(); len];
+            let mut lin = vec![Complex64::default(); len];
+            loop {
+                hb.linear.apply_stiffness(&u, &mut lin);
+                let scale = norm(hb.load()).max(norm(&lin)).max(f64::MIN_POSITIVE);
+                let r_norm = norm(&r);
+                relative = r_norm / scale;
+                if relative <= self.tolerance {
+                    converged = true;
+                    break;
+                }
+                if iterations >= self.max_iterations {
+                    break;
+                }
+                iterations += 1;
+                let blocks = preconditioner(hb, &ws);
+                let m = hb.coordinates();
+                let rhs: Vec<Complex64> = r.iter().map(|v| -v).collect();
+                let out = {
+                    let ws = &mut ws;
+                    let ws_cell = std::cell::RefCell::new(ws);
+                    gmres(
+                        |v, out| hb.jacobian_apply(v, out, &mut ws_cell.borrow_mut()),
+                        |v| apply_blocks(&blocks, m, v),
+                        &rhs,
+                        &mut step,
+                        self.forcing.min(0.1),
+                        self.restart,
+                        self.max_linear,
+                    )
+                };
+                linear += out.iterations;
+                // Backtracking on ‖R‖ (Armijo with a small slope).
+                let mut alpha = 1.0;
+                let mut accepted = false;
+                for _ in 0..12 {
+                    for ((t, x), s) in trial.iter_mut().zip(&u).zip(&step) {
+                        *t = x + s * alpha;
+                    }
+                    hb.residual_into(&trial, &mut r_trial, true, &mut ws)?;
+                    if norm(&r_trial) <= (1.0 - 1e-4 * alpha) * r_norm {
+                        accepted = true;
+                        break;
+                    }
+                    alpha *= 0.5;
+                }
+                if !accepted {
+                    hb.residual_into(&u, &mut r, true, &mut ws)?;
+                    break;
+                }
+                std::mem::swap(&mut u, &mut trial);
+                std::mem::swap(&mut r, &mut r_trial);
+            }
+        }
+        let q = hb.full_harmonics(&u, &mut ws)?;
+        Ok(solution(
+            hb, &u, &q, relative, converged, iterations, linear,
+        ))
+    }
+}
+
+/// `P_j⁻¹` per line: the inverse of `G_j⁻¹ + diag(ḡ_u + i ν_j ḡ_u̇)`.
+fn preconditioner(hb: &TorusBalance, ws: &TorusWorkspace) -> Vec<DMatrix<Complex64>> {
+    let means = hb.mean_derivatives(ws);
+    hb.linear
+        .stiffness
+        .iter()
+        .enumerate()
+        .map(|(j, g)| {
+            let nu = hb.frequency(j);
+            let mut p = g.clone();
+            for (c, (a, b)) in means.iter().enumerate() {
+                p[(c, c)] += Complex64::new(*a, nu * b);
+            }
+            p.clone().try_inverse().unwrap_or_else(|| {
+                DMatrix::from_diagonal(&p.diagonal().map(|v| {
+                    if v.norm() > 0.0 {
+                        1.0 / v
+                    } else {
+                        Complex64::new(1.0, 0.0)
+                    }
+                }))
+            })
+        })
+        .collect()
+}
+
+fn apply_blocks(blocks: &[DMatrix<Complex64>], m: usize, v: &mut [Complex64]) {
+    let mut tmp = [Complex64::default(); 16];
+    for (j, p) in blocks.iter().enumerate() {
+        let x = &mut v[j * m..(j + 1) * m];
+        if m <= 16 {
+            for a in 0..m {
+                tmp[a] = (0..m).map(|b| p[(a, b)] * x[b]).sum();
+            }
+            x.copy_from_slice(&tmp[..m]);
+        } else {
+            let y: Vec<Complex64> = (0..m)
+                .map(|a| (0..m).map(|b| p[(a, b)] * x[b]).sum())
+                .collect();
+            x.copy_from_slice(&y);
+        }
+    }
+}
+
+fn solution(
+    hb: &TorusBalance,
+    u: &[Complex64],
+    q: &[Complex64],
+    relative: f64,
+    converged: bool,
+    iterations: usize,
+    linear: usize,
+) -> TorusSolution {
+    let tm = hb.torus_model();
+    let set = hb.set();
+    TorusSolution {
+        omega: hb.omega(),
+        bases: tm.bases().names().to_vec(),
+        ratios: tm.bases().ratios().to_vec(),
+        dofs: tm.model().dof_names().to_vec(),
+        indices: (0..set.len()).map(|j| set.k(j).to_vec()).collect(),
+        frequencies: (0..set.len()).map(|j| hb.frequency(j)).collect(),
+        harmonics: q.iter().map(|v| (v.re, v.im)).collect(),
+        unknowns: u.iter().map(|v| (v.re, v.im)).collect(),
+        relative_residual: relative,
+        converged,
+        iterations,
+        linear_iterations: linear,
+    }
+}
