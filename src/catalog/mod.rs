@@ -10,6 +10,8 @@ pub mod drivetrain;
 pub use drivetrain::Drivetrain;
 mod mesh_chain;
 pub use mesh_chain::MeshChain;
+mod two_stage_train;
+pub use two_stage_train::TwoStageTrain;
 
 /// The paper's two-shaft model (Bauer et al. 2021, section 4) with the values of hbal's issue 2
 /// (shared with `../shared/reference/seed_rect_6000rpm.json`).

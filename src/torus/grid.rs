@@ -37,6 +37,10 @@ pub struct TorusFft {
     half: usize,
     rows: usize,
     slots: Vec<Slot>,
+    /// Per axis a < d-1, the lines along it (by their position over the axes after a) that
+    /// hold a coefficient of the set: the only ones synthesis finds nonzero and analysis
+    /// needs (see [`TorusFft::along_axis`]).
+    lines: Vec<Vec<usize>>,
     forward_rows: Arc<dyn RealToComplex<f64>>,
     inverse_rows: Arc<dyn ComplexToReal<f64>>,
     /// Forward and inverse complex FFTs along each axis but the last.
@@ -117,12 +121,14 @@ impl TorusFft {
             half,
             rows,
             slots: Vec::new(),
+            lines: Vec::new(),
             forward_rows,
             inverse_rows,
             axes,
             scratch_len,
         };
         plan.slots = (0..set.len()).map(|j| plan.slot(set.k(j))).collect();
+        plan.lines = (0..d - 1).map(|a| plan.lines_along(a)).collect();
         Ok(plan)
     }
 
@@ -222,7 +228,8 @@ impl TorusFft {
         for (row, x) in s.spectrum.chunks_mut(self.half).zip(x.chunks_mut(last)) {
             let _ = self.forward_rows.process_with_scratch(x, row, &mut s.fft);
         }
-        for a in 0..self.axes.len() {
+        // The axes in reverse: each transform then only needs the lines that lead to a slot.
+        for a in (0..self.axes.len()).rev() {
             self.along_axis(a, true, s);
         }
         let scale = 1.0 / self.points() as f64;
@@ -234,30 +241,55 @@ impl TorusFft {
         }
     }
 
-    /// The complex FFT along axis `a` (< d-1) of the half spectrum, in place.
-    fn along_axis(&self, a: usize, forward: bool, s: &mut TorusScratch) {
-        let n = self.dims[a];
-        let stride: usize = self.dims[a + 1..self.dims.len() - 1]
+    /// The stride of axis `a` (< d-1) in the half spectrum: the positions over the later axes.
+    fn stride(&self, a: usize) -> usize {
+        self.dims[a + 1..self.dims.len() - 1]
             .iter()
             .product::<usize>()
-            * self.half;
+            * self.half
+    }
+
+    /// The lines along axis `a` that meet a slot, by their position over the later axes.
+    fn lines_along(&self, a: usize) -> Vec<usize> {
+        let stride = self.stride(a);
+        let mut lines: Vec<usize> = self
+            .slots
+            .iter()
+            .flat_map(|s| std::iter::once(s.at).chain(s.mirror))
+            .map(|at| at % stride)
+            .collect();
+        lines.sort_unstable();
+        lines.dedup();
+        lines
+    }
+
+    /// The complex FFT along axis `a` (< d-1) of the half spectrum, in place, on the lines
+    /// that meet a slot only. Synthesis transforms the axes in order 0, 1, …: before axis a,
+    /// a line along it is nonzero only if its position over the later axes is a slot's (the
+    /// earlier axes are transformed, the later ones not yet). Analysis transforms them in
+    /// reverse, so that after axis a only the lines whose later positions lead to a slot are
+    /// read again: the same lines.
+    fn along_axis(&self, a: usize, forward: bool, s: &mut TorusScratch) {
+        let n = self.dims[a];
+        let stride = self.stride(a);
         let fft = if forward {
             &self.axes[a].0
         } else {
             &self.axes[a].1
         };
-        let block = n * stride;
-        for chunk in s.spectrum.chunks_mut(block) {
-            let buf = &mut s.lines[..block];
-            for i in 0..stride {
-                for j in 0..n {
-                    buf[i * n + j] = chunk[j * stride + i];
+        let lines = &self.lines[a];
+        let used = n * lines.len();
+        for chunk in s.spectrum.chunks_mut(n * stride) {
+            let buf = &mut s.lines[..used];
+            for (line, &i) in buf.chunks_mut(n).zip(lines) {
+                for (j, v) in line.iter_mut().enumerate() {
+                    *v = chunk[j * stride + i];
                 }
             }
             fft.process_with_scratch(buf, &mut s.fft);
-            for i in 0..stride {
-                for j in 0..n {
-                    chunk[j * stride + i] = buf[i * n + j];
+            for (line, &i) in buf.chunks(n).zip(lines) {
+                for (j, v) in line.iter().enumerate() {
+                    chunk[j * stride + i] = *v;
                 }
             }
         }

@@ -18,7 +18,9 @@ pub struct NewtonKrylov {
     pub tolerance: f64,
     /// Most Newton steps.
     pub max_iterations: usize,
-    /// Relative tolerance of each step's linear solve.
+    /// Largest relative tolerance of a step's linear solve (the forcing term); each step
+    /// asks for `min(forcing, 0.9 (‖R_k‖/‖R_{k-1}‖)²)` (Eisenstat & Walker 1996, choice 2),
+    /// never below what the tolerance needs.
     pub forcing: f64,
     /// GMRES restart length.
     pub restart: usize,
@@ -31,9 +33,9 @@ impl Default for NewtonKrylov {
         Self {
             tolerance: 1e-10,
             max_iterations: 40,
-            forcing: 1e-3,
-            restart: 40,
-            max_linear: 400,
+            forcing: 0.1,
+            restart: 120,
+            max_linear: 360,
         }
     }
 }
@@ -59,6 +61,7 @@ impl NewtonKrylov {
             let mut r_trial = vec![Complex64::default(); len];
             let mut step = vec![Complex64::default(); len];
             let mut lin = vec![Complex64::default(); len];
+            let mut previous = f64::INFINITY;
             loop {
                 hb.linear.apply_stiffness(&u, &mut lin);
                 let scale = norm(hb.load()).max(norm(&lin)).max(f64::MIN_POSITIVE);
@@ -72,6 +75,16 @@ impl NewtonKrylov {
                     break;
                 }
                 iterations += 1;
+                let ratio = r_norm / previous;
+                previous = r_norm;
+                let eta = if ratio.is_finite() {
+                    0.9 * ratio * ratio
+                } else {
+                    self.forcing
+                }
+                .min(self.forcing)
+                .max(0.5 * self.tolerance / relative)
+                .min(0.5);
                 let blocks = preconditioner(hb, &ws);
                 let m = hb.coordinates();
                 let rhs: Vec<Complex64> = r.iter().map(|v| -v).collect();
@@ -83,7 +96,7 @@ impl NewtonKrylov {
                         |v| apply_blocks(&blocks, m, v),
                         &rhs,
                         &mut step,
-                        self.forcing.min(0.1),
+                        eta,
                         self.restart,
                         self.max_linear,
                     )
