@@ -42,6 +42,8 @@
 
 mod balance;
 mod bases;
+mod elements;
+mod estimate;
 mod gmres;
 mod grid;
 mod index_set;

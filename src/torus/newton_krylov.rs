@@ -125,9 +125,15 @@ impl NewtonKrylov {
             }
         }
         let q = hb.full_harmonics(&u, &mut ws)?;
-        Ok(solution(
-            hb, &u, &q, relative, converged, iterations, linear,
-        ))
+        let truncation = hb.truncation_estimates(&u, &mut ws)?;
+        Ok(TorusSolution {
+            relative_residual: relative,
+            converged,
+            iterations,
+            linear_iterations: linear,
+            truncation,
+            ..solution(hb, &u, &q)
+        })
     }
 }
 
@@ -175,15 +181,8 @@ fn apply_blocks(blocks: &[DMatrix<Complex64>], m: usize, v: &mut [Complex64]) {
     }
 }
 
-fn solution(
-    hb: &TorusBalance,
-    u: &[Complex64],
-    q: &[Complex64],
-    relative: f64,
-    converged: bool,
-    iterations: usize,
-    linear: usize,
-) -> TorusSolution {
+/// The structural fields of a solution (the solver fills in how it got there).
+fn solution(hb: &TorusBalance, u: &[Complex64], q: &[Complex64]) -> TorusSolution {
     let tm = hb.torus_model();
     let set = hb.set();
     TorusSolution {
@@ -195,9 +194,10 @@ fn solution(
         frequencies: (0..set.len()).map(|j| hb.frequency(j)).collect(),
         harmonics: q.iter().map(|v| (v.re, v.im)).collect(),
         unknowns: u.iter().map(|v| (v.re, v.im)).collect(),
-        relative_residual: relative,
-        converged,
-        iterations,
-        linear_iterations: linear,
+        relative_residual: f64::NAN,
+        converged: false,
+        iterations: 0,
+        linear_iterations: 0,
+        truncation: Vec::new(),
     }
 }

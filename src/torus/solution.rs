@@ -30,6 +30,11 @@ pub struct TorusSolution {
     pub iterations: usize,
     /// Jacobian-vector products of the Krylov solver.
     pub linear_iterations: usize,
+    /// Per base, what its truncation lacks: the response on the first lines beyond its cap
+    /// relative to the alternating response, on the element coordinates (see
+    /// [`TorusBalance::truncation_estimates`](super::TorusBalance::truncation_estimates));
+    /// `None` where the grid cannot resolve one more harmonic of the base.
+    pub truncation: Vec<Option<f64>>,
 }
 
 impl TorusSolution {
