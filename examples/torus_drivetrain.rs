@@ -1,110 +1,101 @@
-//! The free-free two-stage drivetrain of issue 34 on the torus: one point and a run-up, with
-//! times (medians) and how far each result is converged.
+//! The free-free two-stage drivetrain of issue 34 on the torus (engine half orders, mesh 1 and
+//! mesh 2 as three bases): one point from the linear start and a 200-point run-up
+//! 1000 → 6000 rpm, with times (medians), convergence and the per-base truncation estimate.
 //!
-//! `cargo run --release --example torus_drivetrain`
+//! `cargo run --release --example torus_drivetrain [-- CAPS SAMPLES [TOTAL]]`, e.g.
+//! `-- 8,8,8 32,32,32 12` for caps (8, 8, 8) on a 32³ grid in a diamond of total degree 12
+//! (default: caps 8,4,4, grid 32,16,16, a box).
 
 use hbal::catalog::TwoStageTrain;
-use hbal::torus::{IndexSet, NewtonKrylov, TorusBalance, Truncation};
+use hbal::torus::{IndexSet, NewtonKrylov, TorusBalance, TorusSweep, Truncation};
 use std::time::Instant;
 
-fn rpm(x: f64) -> f64 {
-    x * std::f64::consts::TAU / 60.0
+fn rad_per_s(rpm: f64) -> f64 {
+    rpm * std::f64::consts::TAU / 60.0
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }
 
 fn main() -> hbal::Result<()> {
-    let train = TwoStageTrain::default();
-    let model = train.model()?;
-    let caps = [8, 4, 4];
-    let samples: Vec<usize> = std::env::var("SAMPLES")
-        .map(|v| v.split(',').map(|x| x.parse().unwrap()).collect())
-        .unwrap_or(vec![32, 16, 16]);
-    let caps: Vec<usize> = std::env::var("CAPS")
-        .map(|v| v.split(',').map(|x| x.parse().unwrap()).collect())
-        .unwrap_or(caps.to_vec());
-    let set = IndexSet::new(&TwoStageTrain::bases()?, &caps, Truncation::Box)?;
+    let model = TwoStageTrain::default().model()?;
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let list = |i: usize, default: [usize; 3]| -> Vec<usize> {
+        args.get(i).map_or(default.to_vec(), |s| {
+            s.split(',')
+                .map(|x| x.parse().expect("a list like 8,4,4"))
+                .collect()
+        })
+    };
+    let (caps, samples) = (list(0, [8, 4, 4]), list(1, [32, 16, 16]));
+    let truncation = args
+        .get(2)
+        .map_or(Truncation::Box, |t| Truncation::Diamond {
+            total: t.parse().expect("a total degree"),
+        });
+    let set = IndexSet::new(&TwoStageTrain::bases()?, &caps, truncation)?;
     println!(
-        "two-stage train: {} DOFs, caps {caps:?}, {} lines, grid {samples:?}",
+        "two-stage train: {} DOFs, bases {:?}, caps {caps:?} ({truncation:?}), {} lines, grid {samples:?}",
         model.n_dofs(),
+        TwoStageTrain::bases()?.names(),
         set.len()
     );
     let solver = NewtonKrylov::default();
-    let mut times = Vec::new();
-    let mut last = None;
-    if let Ok(speed) = std::env::var("AT_RPM") {
-        let hb = TorusBalance::new(
-            TwoStageTrain::bind(&model)?,
-            set.clone(),
-            &samples,
-            rpm(speed.parse().unwrap()),
-        )?;
-        let sol = solver.solve(&hb, None)?;
-        println!("{}", sol.relative_residual);
-        return Ok(());
-    }
-    let mut setup = Vec::new();
+    let (mut total, mut setup, mut last) = (Vec::new(), Vec::new(), None);
     for _ in 0..15 {
         let t = Instant::now();
-        let hb = TorusBalance::new(
-            TwoStageTrain::bind(&model)?,
-            set.clone(),
-            &samples,
-            rpm(3000.0),
-        )?;
+        let bound = TwoStageTrain::bind(&model)?;
+        let hb = TorusBalance::new(bound, set.clone(), &samples, rad_per_s(3000.0))?;
         setup.push(t.elapsed().as_secs_f64());
-        let sol = solver.solve(&hb, None)?;
-        times.push(t.elapsed().as_secs_f64());
-        last = Some(sol);
+        last = Some(solver.solve(&hb, None)?);
+        total.push(t.elapsed().as_secs_f64());
     }
-    times.sort_by(f64::total_cmp);
-    setup.sort_by(f64::total_cmp);
-    let sol = last.unwrap();
+    let sol = last.expect("15 runs");
     println!(
-        "one point at 3000 rpm from the linear start: {:.1} ms (median of 15; {:.1} ms of it to set up), {} Newton steps, {} Jacobian products, residual {:.1e}, converged {}",
-        1e3 * times[7],
-        1e3 * setup[7],
+        "one point at 3000 rpm from the linear start: {:.1} ms (median of 15; {:.1} ms to set up), {} Newton steps, {} Jacobian products, residual {:.1e}, converged {}",
+        1e3 * median(total),
+        1e3 * median(setup),
         sol.iterations,
         sol.linear_iterations,
         sol.relative_residual,
         sol.converged
     );
+    for (name, e) in sol.bases.iter().zip(&sol.truncation) {
+        match e {
+            Some(e) => println!("  truncation of base `{name}`: {e:.1e} of the alternating TE"),
+            None => println!("  truncation of base `{name}`: not estimated (grid too coarse)"),
+        }
+    }
     let points = 200;
+    let speeds: Vec<f64> = (0..points)
+        .map(|i| rad_per_s(1000.0 + 5000.0 * i as f64 / (points - 1) as f64))
+        .collect();
     let t = Instant::now();
-    let mut hb = TorusBalance::new(
-        TwoStageTrain::bind(&model)?,
-        set.clone(),
-        &samples,
-        rpm(1000.0),
-    )?;
-    let mut start: Option<Vec<_>> = None;
-    let (mut failed, mut steps, mut products) = (0, 0, 0);
-    let mut worst: f64 = 0.0;
-    for i in 0..points {
-        let speed = 1000.0 + 5000.0 * i as f64 / (points - 1) as f64;
-        hb.set_omega(rpm(speed))?;
-        let mut sol = solver.solve(&hb, start.as_deref())?;
-        if !sol.converged && start.is_some() {
-            sol = solver.solve(&hb, None)?;
-        }
-        failed += usize::from(!sol.converged);
-        if !sol.converged || std::env::var("VERBOSE").is_ok() {
-            eprintln!(
-                "{speed:.0} rpm: {} steps, {} products, residual {:.1e}",
-                sol.iterations, sol.linear_iterations, sol.relative_residual
-            );
-        }
-        steps += sol.iterations;
-        products += sol.linear_iterations;
-        worst = worst.max(sol.relative_residual);
-        start = Some(
-            sol.unknowns
-                .iter()
-                .map(|&(a, b)| hbal::num_complex::Complex64::new(a, b))
-                .collect(),
+    let bound = TwoStageTrain::bind(&model)?;
+    let mut hb = TorusBalance::new(bound, set, &samples, speeds[0])?;
+    let sweep = TorusSweep { solver }.run(&mut hb, &speeds, |_, _| {})?;
+    let elapsed = t.elapsed().as_secs_f64();
+    let worst = sweep
+        .points
+        .iter()
+        .map(|p| p.relative_residual)
+        .fold(0.0, f64::max);
+    let steps: usize = sweep.points.iter().map(|p| p.iterations).sum();
+    let products: usize = sweep.points.iter().map(|p| p.linear_iterations).sum();
+    println!(
+        "run-up 1000 -> 6000 rpm, {points} points: {elapsed:.2} s, {} not converged (marked), {steps} Newton steps, {products} Jacobian products, worst residual {worst:.1e}",
+        sweep.failures()
+    );
+    for p in sweep.points.iter().filter(|p| !p.converged) {
+        println!(
+            "  not converged at {:.0} rpm: residual {:.1e}",
+            p.omega * 60.0 / std::f64::consts::TAU,
+            p.relative_residual
         );
     }
-    println!(
-        "run-up 1000 -> 6000 rpm, {points} points: {:.2} s, {failed} not converged, {steps} Newton steps, {products} Jacobian products, worst residual {worst:.1e}",
-        t.elapsed().as_secs_f64()
-    );
+    let hbal::torus::TorusStability::NotComputed { reason } = &sweep.stability;
+    println!("stability: {reason}");
     Ok(())
 }

@@ -51,6 +51,7 @@ mod linear;
 mod model;
 mod newton_krylov;
 mod solution;
+mod sweep;
 
 pub use balance::{TorusBalance, TorusWorkspace};
 pub use bases::Bases;
@@ -59,3 +60,4 @@ pub use index_set::{Index, IndexSet, Truncation};
 pub use model::TorusModel;
 pub use newton_krylov::NewtonKrylov;
 pub use solution::TorusSolution;
+pub use sweep::{TorusStability, TorusSweep, TorusSweepResult};

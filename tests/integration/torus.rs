@@ -4,7 +4,9 @@
 
 use hbal::force::{Backlash, Flank, ForceLaw, MeshDamping, MeshProfile, MeshStiffness};
 use hbal::num_complex::Complex64;
-use hbal::torus::{Bases, IndexSet, NewtonKrylov, TorusBalance, TorusModel, Truncation};
+use hbal::torus::{
+    Bases, IndexSet, NewtonKrylov, TorusBalance, TorusModel, TorusStability, TorusSweep, Truncation,
+};
 use hbal::{Anderson, Formulation, HarmonicBalance, HarmonicBasis, Model};
 
 /// A linear spring written as a user law with no linear part: the AFT, the Jacobian product and
@@ -362,4 +364,89 @@ fn truncation_estimate_names_the_short_base() {
         );
         assert!(e_other < 0.1 * e_short, "caps {caps:?}: {est:?}");
     }
+}
+
+/// A speed sweep of a linear model: every point equals the direct solve at its speed, the
+/// stability is stated as not computed, and bad speeds are refused before any work.
+#[test]
+fn sweep_follows_the_speed_and_states_its_stability() {
+    let model = two_dof(true);
+    let bases = Bases::new(&[("a", 1.0), ("b", 2f64.sqrt())]).unwrap();
+    let tm = TorusModel::new(&model, bases).bind_load(1, "b").unwrap();
+    let set = IndexSet::new(tm.bases(), &[2, 2], Truncation::Box).unwrap();
+    let mut hb = TorusBalance::new(tm, set, &[8, 8], 1.0).unwrap();
+    let speeds = [0.5, 0.9, 1.3, 2.0];
+    let mut seen = Vec::new();
+    let sweep = TorusSweep::default()
+        .run(&mut hb, &speeds, |i, p| seen.push((i, p.omega)))
+        .unwrap();
+    assert_eq!(sweep.failures(), 0);
+    assert_eq!(seen.len(), 4);
+    for (p, &w) in sweep.points.iter().zip(&speeds) {
+        assert_eq!(p.omega, w);
+        let want = one_frequency(1, w * 2f64.sqrt());
+        let got = p.harmonic(0, &[0, 1]);
+        assert!(
+            (got - want[0]).norm() <= 1e-12 * want[0].norm(),
+            "{w}: {got} vs {}",
+            want[0]
+        );
+    }
+    let TorusStability::NotComputed { reason } = &sweep.stability;
+    assert!(reason.contains("no period"), "{reason}");
+    for bad in [vec![], vec![1.0, f64::NAN], vec![-1.0]] {
+        assert!(
+            TorusSweep::default().run(&mut hb, &bad, |_, _| {}).is_err(),
+            "{bad:?}"
+        );
+    }
+}
+
+/// Bad input: a clear error naming the field, before any work.
+#[test]
+fn bad_input_is_refused_by_name() {
+    let msg = |r: hbal::Result<()>| r.unwrap_err().to_string();
+    assert!(msg(Bases::new(&[("a", f64::NAN)]).map(|_| ())).contains("`ratio`"));
+    assert!(msg(Bases::new(&[("a", 0.0)]).map(|_| ())).contains("`ratio`"));
+    assert!(msg(Bases::new(&[("a", 1.0), ("a", 2.0)]).map(|_| ())).contains("twice"));
+    let five: Vec<(String, f64)> = (0..5)
+        .map(|i| (format!("b{i}"), 1.0 + i as f64 * 0.1))
+        .collect();
+    let five: Vec<(&str, f64)> = five.iter().map(|(n, r)| (n.as_str(), *r)).collect();
+    assert!(msg(Bases::new(&five).map(|_| ())).contains("number of bases"));
+    let bases = Bases::new(&[("a", 1.0), ("b", 2f64.sqrt())]).unwrap();
+    // Too many indices, refused before enumerating them.
+    let big = IndexSet::new(&bases, &[4000, 4000], Truncation::Box);
+    assert!(msg(big.map(|_| ())).contains("index set size"));
+    assert!(
+        msg(IndexSet::new(&bases, &[2], Truncation::Box).map(|_| ())).contains("one cap per base")
+    );
+    // Commensurate within the caps: (2, -1) has frequency zero for ratios 1 and 2.
+    let c = Bases::new(&[("a", 1.0), ("b", 2.0)]).unwrap();
+    assert!(msg(IndexSet::new(&c, &[2, 2], Truncation::Box).map(|_| ())).contains("frequency zero"));
+    let model = two_dof(true);
+    let tm = TorusModel::new(&model, bases.clone());
+    assert!(msg(tm.clone().bind_element("coupling", "c").map(|_| ())).contains("no base `c`"));
+    assert!(msg(tm.clone().bind_element("nope", "a").map(|_| ())).contains("no such element"));
+    assert!(msg(tm.clone().bind_load(7, "a").map(|_| ())).contains("2 loads"));
+    let set = IndexSet::new(&bases, &[2, 2], Truncation::Box).unwrap();
+    // A grid too coarse for the caps, a grid too large, a load beyond its base's cap.
+    let coarse = TorusBalance::new(tm.clone(), set.clone(), &[8, 4], 1.0);
+    assert!(msg(coarse.map(|_| ())).contains("cannot resolve 2 harmonics"));
+    let huge = TorusBalance::new(tm.clone(), set.clone(), &[1 << 12, 1 << 12], 1.0);
+    assert!(msg(huge.map(|_| ())).contains("in all"));
+    let bad_speed = TorusBalance::new(tm.clone(), set.clone(), &[8, 8], f64::INFINITY);
+    assert!(bad_speed.is_err());
+    let high = Model::builder(&["x1", "x2"])
+        .mass_diagonal(&[1.0, 1.0])
+        .stiffness_triplets(&[(0, 0, 1.0), (1, 1, 1.0)])
+        .load("x1", 3, 1.0, 0.0)
+        .build()
+        .unwrap();
+    let err = TorusBalance::new(TorusModel::new(&high, bases), set, &[8, 8], 1.0);
+    let text = msg(err.map(|_| ()));
+    assert!(
+        text.contains("order 3 on base `a`") && text.contains("raise its cap"),
+        "{text}"
+    );
 }
