@@ -92,3 +92,8 @@ pub struct ReadmeDoctests;
 #[doc = include_str!("../docs/library.md")]
 #[cfg(doctest)]
 pub struct LibraryDocDoctests;
+
+/// docs/torus.md's code blocks run as doctests too.
+#[doc = include_str!("../docs/torus.md")]
+#[cfg(doctest)]
+pub struct TorusDocDoctests;
