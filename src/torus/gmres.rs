@@ -24,6 +24,89 @@ fn norm(a: &[Complex64]) -> f64 {
     dot(a, a).sqrt()
 }
 
+/// The Arnoldi basis of one restart cycle with the Hessenberg matrix reduced by Givens
+/// rotations as it grows, and the rotated right-hand side `g` (`|g[k]|` is the residual).
+struct Arnoldi {
+    basis: Vec<Vec<Complex64>>,
+    h: Vec<Vec<f64>>,
+    rotations: Vec<(f64, f64)>,
+    g: Vec<f64>,
+}
+
+impl Arnoldi {
+    fn new(n: usize, restart: usize) -> Self {
+        Self {
+            basis: vec![vec![Complex64::default(); n]; restart + 1],
+            h: vec![vec![0.0; restart]; restart + 1],
+            rotations: vec![(1.0, 0.0); restart],
+            g: vec![0.0; restart + 1],
+        }
+    }
+
+    /// Starts a cycle from the residual in `basis[0]` of norm `beta`.
+    fn start(&mut self, beta: f64) {
+        self.basis[0].iter_mut().for_each(|v| *v /= beta);
+        self.g.fill(0.0);
+        self.g[0] = beta;
+    }
+
+    /// Adds `w = A P⁻¹ v_k` as column k: orthogonalises it (modified Gram–Schmidt), rotates
+    /// the column, and returns the new residual norm and whether the space is exhausted.
+    fn extend(&mut self, k: usize, w: &mut [Complex64]) -> (f64, bool) {
+        for i in 0..=k {
+            let hik = dot(&self.basis[i], w);
+            self.h[i][k] = hik;
+            for (wv, vv) in w.iter_mut().zip(&self.basis[i]) {
+                *wv -= vv * hik;
+            }
+        }
+        let hk1 = norm(w);
+        self.h[k + 1][k] = hk1;
+        if hk1 > 0.0 {
+            for (v, wv) in self.basis[k + 1].iter_mut().zip(w.iter()) {
+                *v = wv / hk1;
+            }
+        }
+        for i in 0..k {
+            let (c, s) = self.rotations[i];
+            let t = c * self.h[i][k] + s * self.h[i + 1][k];
+            self.h[i + 1][k] = -s * self.h[i][k] + c * self.h[i + 1][k];
+            self.h[i][k] = t;
+        }
+        let r = self.h[k][k].hypot(self.h[k + 1][k]);
+        let (c, s) = if r > 0.0 {
+            (self.h[k][k] / r, self.h[k + 1][k] / r)
+        } else {
+            (1.0, 0.0)
+        };
+        self.rotations[k] = (c, s);
+        self.h[k][k] = r;
+        self.h[k + 1][k] = 0.0;
+        self.g[k + 1] = -s * self.g[k];
+        self.g[k] *= c;
+        (self.g[k + 1].abs(), hk1 == 0.0)
+    }
+
+    /// `z ← V y` with `y` from the triangular system of the first `k` columns.
+    fn combination(&self, k: usize, z: &mut [Complex64]) {
+        let mut y = vec![0.0; k];
+        for i in (0..k).rev() {
+            let s: f64 = (i + 1..k).map(|j| self.h[i][j] * y[j]).sum();
+            y[i] = if self.h[i][i] != 0.0 {
+                (self.g[i] - s) / self.h[i][i]
+            } else {
+                0.0
+            };
+        }
+        z.fill(Complex64::default());
+        for (yi, v) in y.iter().zip(&self.basis) {
+            for (zv, vv) in z.iter_mut().zip(v) {
+                *zv += vv * *yi;
+            }
+        }
+    }
+}
+
 /// Solves `A x = b` to `‖b - A x‖ <= tol ‖b‖` or `max_iterations` products, restarting every
 /// `restart`; `x` starts at zero. `apply(v, out)`: `out ← A v`; `precondition(v)`:
 /// `v ← P⁻¹ v`.
@@ -46,88 +129,36 @@ pub(super) fn gmres(
         };
     }
     let restart = restart.max(1);
-    let mut basis: Vec<Vec<Complex64>> = vec![vec![Complex64::default(); n]; restart + 1];
-    let mut h = vec![vec![0.0; restart]; restart + 1];
-    let (mut cs, mut sn, mut g) = (
-        vec![0.0; restart],
-        vec![0.0; restart],
-        vec![0.0; restart + 1],
-    );
-    let mut z = vec![Complex64::default(); n];
-    let mut w = vec![Complex64::default(); n];
+    let mut arnoldi = Arnoldi::new(n, restart);
+    let (mut z, mut w) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
     let mut total = 0;
     let mut residual;
     loop {
-        // r = b - A x.
         apply(x, &mut w);
-        for ((r, bi), wi) in basis[0].iter_mut().zip(b).zip(&w) {
+        for ((r, bi), wi) in arnoldi.basis[0].iter_mut().zip(b).zip(&w) {
             *r = bi - wi;
         }
-        let beta = norm(&basis[0]);
+        let beta = norm(&arnoldi.basis[0]);
         residual = beta / beta0;
         if residual <= tol || total >= max_iterations {
             break;
         }
-        basis[0].iter_mut().for_each(|v| *v /= beta);
-        g.fill(0.0);
-        g[0] = beta;
-        let mut k_used = 0;
+        arnoldi.start(beta);
+        let mut used = 0;
         for k in 0..restart {
-            z.copy_from_slice(&basis[k]);
+            z.copy_from_slice(&arnoldi.basis[k]);
             precondition(&mut z);
             apply(&z, &mut w);
             total += 1;
-            for i in 0..=k {
-                let hik = dot(&basis[i], &w);
-                h[i][k] = hik;
-                for (wv, vv) in w.iter_mut().zip(&basis[i]) {
-                    *wv -= vv * hik;
-                }
-            }
-            let hk1 = norm(&w);
-            h[k + 1][k] = hk1;
-            if hk1 > 0.0 {
-                for (v, wv) in basis[k + 1].iter_mut().zip(&w) {
-                    *v = wv / hk1;
-                }
-            }
-            for i in 0..k {
-                let t = cs[i] * h[i][k] + sn[i] * h[i + 1][k];
-                h[i + 1][k] = -sn[i] * h[i][k] + cs[i] * h[i + 1][k];
-                h[i][k] = t;
-            }
-            let r = h[k][k].hypot(h[k + 1][k]);
-            (cs[k], sn[k]) = if r > 0.0 {
-                (h[k][k] / r, h[k + 1][k] / r)
-            } else {
-                (1.0, 0.0)
-            };
-            h[k][k] = r;
-            h[k + 1][k] = 0.0;
-            g[k + 1] = -sn[k] * g[k];
-            g[k] *= cs[k];
-            k_used = k + 1;
-            residual = g[k + 1].abs() / beta0;
-            if residual <= tol || total >= max_iterations || hk1 == 0.0 {
+            let (r, exhausted) = arnoldi.extend(k, &mut w);
+            used = k + 1;
+            residual = r / beta0;
+            if residual <= tol || total >= max_iterations || exhausted {
                 break;
             }
         }
-        // y from the triangular system, then x += P⁻¹ V y.
-        let mut y = vec![0.0; k_used];
-        for i in (0..k_used).rev() {
-            let s: f64 = (i + 1..k_used).map(|j| h[i][j] * y[j]).sum();
-            y[i] = if h[i][i] != 0.0 {
-                (g[i] - s) / h[i][i]
-            } else {
-                0.0
-            };
-        }
-        z.fill(Complex64::default());
-        for (yi, v) in y.iter().zip(&basis) {
-            for (zv, vv) in z.iter_mut().zip(v) {
-                *zv += vv * *yi;
-            }
-        }
+        // Right preconditioning: x += P⁻¹ V y.
+        arnoldi.combination(used, &mut z);
         precondition(&mut z);
         for (xi, zi) in x.iter_mut().zip(&z) {
             *xi += zi;

@@ -23,6 +23,8 @@ pub(super) struct TorusLinear {
     pub(super) solved: Vec<DMatrix<Complex64>>,
     /// `G_j⁻¹` per line (m × m).
     pub(super) stiffness: Vec<DMatrix<Complex64>>,
+    /// `G_j = Wᵀ Z_j⁻¹ W` per line (m × m), the receptance of the fixed point.
+    pub(super) receptance: Vec<DMatrix<Complex64>>,
     /// `L_j`, line-major (`j m + c`).
     pub(super) load: Vec<Complex64>,
 }
@@ -44,6 +46,7 @@ impl TorusLinear {
         let hysteretic = dense.hysteretic.amax() > 0.0;
         let mut solved = Vec::with_capacity(set.len());
         let mut stiffness = Vec::with_capacity(set.len());
+        let mut receptance = Vec::with_capacity(set.len());
         let mut load = Vec::with_capacity(set.len() * m);
         for j in 0..set.len() {
             let nu = omega * set.ratio(j);
@@ -80,7 +83,8 @@ impl TorusLinear {
             if m > 0 {
                 let g = wc.transpose() * rhs.columns(0, m);
                 let g_scale = g.iter().map(|v| v.norm()).fold(0.0, f64::max);
-                let g_lu = g.lu();
+                let g_lu = g.clone().lu();
+                receptance.push(g);
                 check_pivots(
                     g_lu.u().diagonal().iter().map(|p| p.norm()),
                     g_scale,
@@ -104,6 +108,7 @@ impl TorusLinear {
             m,
             solved,
             stiffness,
+            receptance,
             load,
         })
     }

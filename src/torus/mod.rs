@@ -44,6 +44,7 @@ mod balance;
 mod bases;
 mod elements;
 mod estimate;
+mod fixed_point;
 mod gmres;
 mod grid;
 mod index_set;
@@ -55,6 +56,7 @@ mod sweep;
 
 pub use balance::{TorusBalance, TorusWorkspace};
 pub use bases::Bases;
+pub use fixed_point::TorusFixedPoint;
 pub use grid::{TorusFft, TorusScratch, MAX_GRID};
 pub use index_set::{Index, IndexSet, Truncation};
 pub use model::TorusModel;

@@ -57,16 +57,10 @@ impl NewtonKrylov {
         let mut converged = len == 0;
         if len > 0 {
             hb.residual_into(&u, &mut r, true, &mut ws)?;
-            let mut trial = vec![Complex64::default(); len];
-            let mut r_trial = vec![Complex64::default(); len];
             let mut step = vec![Complex64::default(); len];
-            let mut lin = vec![Complex64::default(); len];
             let mut previous = f64::INFINITY;
             loop {
-                hb.linear.apply_stiffness(&u, &mut lin);
-                let scale = norm(hb.load()).max(norm(&lin)).max(f64::MIN_POSITIVE);
-                let r_norm = norm(&r);
-                relative = r_norm / scale;
+                relative = relative_residual(hb, &u, &r);
                 if relative <= self.tolerance {
                     converged = true;
                     break;
@@ -75,6 +69,7 @@ impl NewtonKrylov {
                     break;
                 }
                 iterations += 1;
+                let r_norm = norm(&r);
                 let ratio = r_norm / previous;
                 previous = r_norm;
                 let eta = if ratio.is_finite() {
@@ -85,56 +80,99 @@ impl NewtonKrylov {
                 .min(self.forcing)
                 .max(0.5 * self.tolerance / relative)
                 .min(0.5);
-                let blocks = preconditioner(hb, &ws);
-                let m = hb.coordinates();
-                let rhs: Vec<Complex64> = r.iter().map(|v| -v).collect();
-                let out = {
-                    let ws = &mut ws;
-                    let ws_cell = std::cell::RefCell::new(ws);
-                    gmres(
-                        |v, out| hb.jacobian_apply(v, out, &mut ws_cell.borrow_mut()),
-                        |v| apply_blocks(&blocks, m, v),
-                        &rhs,
-                        &mut step,
-                        eta,
-                        self.restart,
-                        self.max_linear,
-                    )
-                };
-                linear += out.iterations;
-                // Backtracking on ‖R‖ (Armijo with a small slope).
-                let mut alpha = 1.0;
-                let mut accepted = false;
-                for _ in 0..12 {
-                    for ((t, x), s) in trial.iter_mut().zip(&u).zip(&step) {
-                        *t = x + s * alpha;
-                    }
-                    hb.residual_into(&trial, &mut r_trial, true, &mut ws)?;
-                    if norm(&r_trial) <= (1.0 - 1e-4 * alpha) * r_norm {
-                        accepted = true;
-                        break;
-                    }
-                    alpha *= 0.5;
-                }
-                if !accepted {
-                    hb.residual_into(&u, &mut r, true, &mut ws)?;
+                linear += self.direction(hb, &r, eta, &mut step, &mut ws);
+                if !line_search(hb, &mut u, &mut r, &step, &mut ws)? {
                     break;
                 }
-                std::mem::swap(&mut u, &mut trial);
-                std::mem::swap(&mut r, &mut r_trial);
             }
         }
-        let q = hb.full_harmonics(&u, &mut ws)?;
-        let truncation = hb.truncation_estimates(&u, &mut ws)?;
-        Ok(TorusSolution {
-            relative_residual: relative,
-            converged,
-            iterations,
-            linear_iterations: linear,
-            truncation,
-            ..solution(hb, &u, &q)
-        })
+        finish(hb, &u, &mut ws, relative, converged, iterations, linear)
     }
+
+    /// The Newton direction `step ≈ -J⁻¹ r` to the relative tolerance `eta`; returns the
+    /// Jacobian products it took.
+    fn direction(
+        &self,
+        hb: &TorusBalance,
+        r: &[Complex64],
+        eta: f64,
+        step: &mut [Complex64],
+        ws: &mut TorusWorkspace,
+    ) -> usize {
+        let blocks = preconditioner(hb, ws);
+        let m = hb.coordinates();
+        let rhs: Vec<Complex64> = r.iter().map(|v| -v).collect();
+        let ws = std::cell::RefCell::new(ws);
+        gmres(
+            |v, out| hb.jacobian_apply(v, out, &mut ws.borrow_mut()),
+            |v| apply_blocks(&blocks, m, v),
+            &rhs,
+            step,
+            eta,
+            self.restart,
+            self.max_linear,
+        )
+        .iterations
+    }
+}
+
+/// `‖R‖ / max(‖L‖, ‖G⁻¹ U‖)`.
+pub(super) fn relative_residual(hb: &TorusBalance, u: &[Complex64], r: &[Complex64]) -> f64 {
+    let mut lin = vec![Complex64::default(); u.len()];
+    hb.linear.apply_stiffness(u, &mut lin);
+    norm(r) / norm(hb.load()).max(norm(&lin)).max(f64::MIN_POSITIVE)
+}
+
+/// Backtracking along `step` from `u` (Armijo on ‖R‖ with a small slope, 12 halvings): moves
+/// `u` and its residual `r` (with the Jacobian's samples) on success; `false` (and `u`, `r`
+/// as they were) where no step lowers ‖R‖.
+fn line_search(
+    hb: &TorusBalance,
+    u: &mut Vec<Complex64>,
+    r: &mut Vec<Complex64>,
+    step: &[Complex64],
+    ws: &mut TorusWorkspace,
+) -> Result<bool> {
+    let r_norm = norm(r);
+    let mut trial = vec![Complex64::default(); u.len()];
+    let mut r_trial = vec![Complex64::default(); u.len()];
+    let mut alpha = 1.0;
+    for _ in 0..12 {
+        for ((t, x), s) in trial.iter_mut().zip(u.iter()).zip(step) {
+            *t = x + s * alpha;
+        }
+        hb.residual_into(&trial, &mut r_trial, true, ws)?;
+        if norm(&r_trial) <= (1.0 - 1e-4 * alpha) * r_norm {
+            *u = trial;
+            *r = r_trial;
+            return Ok(true);
+        }
+        alpha *= 0.5;
+    }
+    hb.residual_into(u, r, true, ws)?;
+    Ok(false)
+}
+
+/// The solution at `u`: full harmonics, truncation estimates, and how the solver got there.
+pub(super) fn finish(
+    hb: &TorusBalance,
+    u: &[Complex64],
+    ws: &mut TorusWorkspace,
+    relative: f64,
+    converged: bool,
+    iterations: usize,
+    linear: usize,
+) -> Result<TorusSolution> {
+    let q = hb.full_harmonics(u, ws)?;
+    let truncation = hb.truncation_estimates(u, ws)?;
+    Ok(TorusSolution {
+        relative_residual: relative,
+        converged,
+        iterations,
+        linear_iterations: linear,
+        truncation,
+        ..solution(hb, u, &q)
+    })
 }
 
 /// `P_j⁻¹` per line: the inverse of `G_j⁻¹ + diag(ḡ_u + i ν_j ḡ_u̇)`.

@@ -5,7 +5,8 @@
 use hbal::force::{Backlash, Flank, ForceLaw, MeshDamping, MeshProfile, MeshStiffness};
 use hbal::num_complex::Complex64;
 use hbal::torus::{
-    Bases, IndexSet, NewtonKrylov, TorusBalance, TorusModel, TorusStability, TorusSweep, Truncation,
+    Bases, IndexSet, NewtonKrylov, TorusBalance, TorusFixedPoint, TorusModel, TorusStability,
+    TorusSweep, Truncation,
 };
 use hbal::{Anderson, Formulation, HarmonicBalance, HarmonicBasis, Model};
 
@@ -449,4 +450,36 @@ fn bad_input_is_refused_by_name() {
         text.contains("order 3 on base `a`") && text.contains("raise its cap"),
         "{text}"
     );
+}
+
+/// The paper's fixed point on the torus reaches the Newton–Krylov solution of the rippled
+/// train (contact closed) to 1e-9 of the TE; a relaxation outside (0, 1] is refused.
+#[test]
+fn fixed_point_agrees_with_newton_krylov() {
+    let model = two_stage_rippled([1, 1], 1, 400.0);
+    let bases = Bases::new(&[("mesh 1", 67.0), ("mesh 2", 19.0)]).unwrap();
+    let tm = TorusModel::new(&model, bases)
+        .bind_element("stage 2", "mesh 2")
+        .unwrap();
+    let set = IndexSet::new(tm.bases(), &[6, 6], Truncation::Box).unwrap();
+    let hb = TorusBalance::new(tm, set, &[32, 32], 20.0).unwrap();
+    let newton = NewtonKrylov::default().solve(&hb, None).unwrap();
+    let fixed = TorusFixedPoint::default().solve(&hb, None).unwrap();
+    assert!(fixed.converged, "{}", fixed.relative_residual);
+    assert!(fixed.iterations > 1);
+    let (mut diff, mut size) = (0.0f64, 0.0f64);
+    for (a, b) in newton.unknowns.iter().zip(&fixed.unknowns).skip(2) {
+        diff = diff.max((a.0 - b.0).hypot(a.1 - b.1));
+        size = size.max(a.0.hypot(a.1));
+    }
+    assert!(diff <= 1e-9 * size, "{diff:e} of {size:e}");
+    let bad = TorusFixedPoint {
+        gamma: 0.0,
+        ..Default::default()
+    };
+    assert!(bad
+        .solve(&hb, None)
+        .unwrap_err()
+        .to_string()
+        .contains("`gamma`"));
 }
