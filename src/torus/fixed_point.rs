@@ -52,8 +52,11 @@ impl TorusFixedPoint {
         let mut r = vec![Complex64::default(); len];
         let (mut best, mut best_u) = (f64::INFINITY, u.clone());
         let mut iterations = 0;
-        let mut converged = len == 0;
-        while len > 0 {
+        let mut converged = false;
+        if len == 0 {
+            return finish(hb, &u, &mut ws, 0.0, true, 0, 0);
+        }
+        loop {
             hb.residual_into(&u, &mut r, false, &mut ws)?;
             let relative = relative_residual(hb, &u, &r);
             if relative < best {
@@ -74,7 +77,6 @@ impl TorusFixedPoint {
                 }
             }
         }
-        let relative = if len == 0 { 0.0 } else { best };
-        finish(hb, &best_u, &mut ws, relative, converged, iterations, 0)
+        finish(hb, &best_u, &mut ws, best, converged, iterations, 0)
     }
 }
