@@ -33,6 +33,8 @@ pub struct TorusBalance<'m> {
     thetas: Vec<Vec<f64>>,
     pub(super) dense: crate::model::DenseMatrices,
     pub(super) augmentation: Option<DMatrix<f64>>,
+    /// The rigid-body modes of a free-free model, whose mean loads must balance at every speed.
+    rigid: Option<crate::model::RigidModes>,
     pub(super) w: DMatrix<f64>,
     f_full: Vec<Complex64>,
     pub(super) linear: TorusLinear,
@@ -66,11 +68,14 @@ impl<'m> TorusBalance<'m> {
     /// on a free-free model.
     pub fn new(tm: TorusModel<'m>, set: IndexSet, samples: &[usize], omega: f64) -> Result<Self> {
         let model = tm.model();
-        if set.dims() != tm.bases().len() {
-            return Err(Error::DimensionMismatch {
-                context: "torus index set (one cap per base)".into(),
-                expected: tm.bases().len().to_string(),
-                got: set.dims().to_string(),
+        if set.base_ratios() != tm.bases().ratios() {
+            return Err(Error::InvalidElement {
+                context: "torus index set".into(),
+                reason: format!(
+                    "it was built for bases with ratios {:?}, the model's bases have {:?}",
+                    set.base_ratios(),
+                    tm.bases().ratios()
+                ),
             });
         }
         crate::harmonic::HarmonicBasis::new(omega, 0)?;
@@ -97,7 +102,7 @@ impl<'m> TorusBalance<'m> {
                 .map(|(_, v)| v)
                 .sum()
         });
-        let mut augmentation = None;
+        let (mut augmentation, mut rigid_modes) = (None, None);
         let linear = match TorusLinear::new(&dense, None, &set, omega, &w, &f_full) {
             Err(e @ Error::SingularDynamicStiffness { harmonic: 0, .. }) => {
                 let rigid = crate::model::rigid::find_dense(model, &dense).ok_or(e)?;
@@ -106,6 +111,7 @@ impl<'m> TorusBalance<'m> {
                 let a = rigid.augmentation();
                 let linear = TorusLinear::new(&dense, Some(&a), &set, omega, &w, &f_full)?;
                 augmentation = Some(a);
+                rigid_modes = Some(rigid);
                 linear
             }
             r => r?,
@@ -121,6 +127,7 @@ impl<'m> TorusBalance<'m> {
             thetas,
             dense,
             augmentation,
+            rigid: rigid_modes,
             w,
             f_full,
             linear,
@@ -132,6 +139,12 @@ impl<'m> TorusBalance<'m> {
         crate::harmonic::HarmonicBasis::new(omega, 0)?;
         self.tm.model().check_load_speeds(omega, omega)?;
         let f_full = full_load(&self.tm, &self.set, omega)?;
+        if let Some(rigid) = &self.rigid {
+            // A static load over speed may stop balancing: no periodic solution there.
+            let n = self.tm.model().n_dofs();
+            let mean: Vec<f64> = f_full[..n].iter().map(|v| v.re).collect();
+            rigid.check_balance(self.tm.model(), &mean)?;
+        }
         let aug = self.augmentation.as_ref();
         self.linear = TorusLinear::new(&self.dense, aug, &self.set, omega, &self.w, &f_full)?;
         self.f_full = f_full;
@@ -239,13 +252,11 @@ impl<'m> TorusBalance<'m> {
     ) -> Result<()> {
         self.rest_into(u, out, derivatives, ws)?;
         let m = self.coordinates();
-        let mut lin = vec![Complex64::default(); m];
         for (j, g) in self.linear.stiffness.iter().enumerate() {
-            for (a, l) in lin.iter_mut().enumerate() {
-                *l = (0..m).map(|b| g[(a, b)] * u[j * m + b]).sum();
-            }
-            for c in 0..m {
-                out[j * m + c] += lin[c] - self.linear.load[j * m + c];
+            let x = &u[j * m..(j + 1) * m];
+            for (a, o) in out[j * m..(j + 1) * m].iter_mut().enumerate() {
+                let lin: Complex64 = x.iter().enumerate().map(|(b, v)| g[(a, b)] * v).sum();
+                *o += lin - self.linear.load[j * m + a];
             }
         }
         Ok(())

@@ -86,11 +86,15 @@ pub(super) fn active_elements(
             });
         }
         if let Some(order) = e.law().time_order() {
-            if order > cap {
+            let mut k = vec![0i32; set.dims()];
+            k[base] = i32::try_from(order).unwrap_or(i32::MAX);
+            if !set.contains_either_sign(&k) {
                 return Err(Error::InvalidElement {
                     context,
                     reason: format!(
-                        "the law varies at order {order} of its base but only {cap} harmonics of it are kept: raise the cap or bind it to a base that turns {order} times faster"
+                        "the law varies at order {order} of its base but the index set does not hold that line (caps {:?}, {:?}): raise the cap or the total degree, or bind it to a base that turns {order} times faster",
+                        set.caps(),
+                        set.truncation()
                     ),
                 });
             }

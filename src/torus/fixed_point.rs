@@ -7,7 +7,7 @@
 //! against the linear part (a closed contact, a mild nonlinearity); Newton–Krylov
 //! ([`super::NewtonKrylov`]) where it is not.
 
-use super::newton_krylov::{finish, relative_residual};
+use super::newton_krylov::{finish, relative_residual, start_of};
 use super::{TorusBalance, TorusSolution};
 use crate::error::{Error, Result};
 use num_complex::Complex64;
@@ -47,7 +47,7 @@ impl TorusFixedPoint {
             ));
         }
         let mut ws = hb.workspace();
-        let mut u = start.map_or_else(|| hb.linear_start(), <[Complex64]>::to_vec);
+        let mut u = start_of(hb, start)?;
         let (len, m) = (hb.len(), hb.coordinates());
         let mut r = vec![Complex64::default(); len];
         let (mut best, mut best_u) = (f64::INFINITY, u.clone());

@@ -30,6 +30,8 @@ pub type Index = [i32; Bases::MAX];
 #[derive(Debug, Clone, PartialEq)]
 pub struct IndexSet {
     d: usize,
+    /// The ratios of the bases it was built for.
+    base_ratios: Vec<f64>,
     caps: Vec<usize>,
     truncation: Truncation,
     indices: Vec<Index>,
@@ -97,35 +99,28 @@ impl IndexSet {
             ));
         }
         let r = bases.ratios();
-        let mut entries: Vec<(Index, f64)> = Vec::new();
-        let mut k: Index = [0; Bases::MAX];
-        for (b, &c) in caps.iter().enumerate() {
-            k[b] = -(c as i32);
-        }
-        loop {
-            let degree: usize = k[..d].iter().map(|v| v.unsigned_abs() as usize).sum();
-            let inside = match truncation {
-                Truncation::Box => true,
-                Truncation::Diamond { total } => degree <= total,
-            };
-            if inside {
-                let ratio: f64 = (0..d).map(|b| k[b] as f64 * r[b]).sum();
-                let scale: f64 = (0..d).map(|b| (k[b] as f64 * r[b]).abs()).sum();
-                if degree == 0 {
-                    entries.push((k, 0.0));
-                } else if ratio.abs() <= 1e-10 * scale {
-                    return Err(commensurate(bases, &k[..d]));
-                } else if ratio > 0.0 {
-                    entries.push((k, ratio));
-                }
-            }
-            if !next(&mut k[..d], caps) {
-                break;
+        let budget = match truncation {
+            Truncation::Box => usize::MAX,
+            Truncation::Diamond { total } => total,
+        };
+        let mut all = Vec::new();
+        enumerate(caps, budget, &mut [0; Bases::MAX], 0, &mut all);
+        let mut entries: Vec<(Index, f64)> = Vec::with_capacity(all.len() / 2 + 1);
+        for k in all {
+            let ratio: f64 = (0..d).map(|b| k[b] as f64 * r[b]).sum();
+            let scale: f64 = (0..d).map(|b| (k[b] as f64 * r[b]).abs()).sum();
+            if k[..d].iter().all(|&v| v == 0) {
+                entries.push((k, 0.0));
+            } else if ratio.abs() <= 1e-10 * scale {
+                return Err(commensurate(bases, &k[..d]));
+            } else if ratio > 0.0 {
+                entries.push((k, ratio));
             }
         }
         entries.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
         Ok(Self {
             d,
+            base_ratios: r.to_vec(),
             caps: caps.to_vec(),
             truncation,
             indices: entries.iter().map(|e| e.0).collect(),
@@ -146,6 +141,11 @@ impl IndexSet {
     /// Number of bases d.
     pub fn dims(&self) -> usize {
         self.d
+    }
+
+    /// The ratios `r_b` of the bases the set was built for.
+    pub fn base_ratios(&self) -> &[f64] {
+        &self.base_ratios
     }
 
     /// The caps `H_b`.
@@ -187,16 +187,19 @@ impl IndexSet {
     }
 }
 
-/// The next `k` in the box `|k_b| <= caps[b]` (last entry fastest); `false` after the last.
-fn next(k: &mut [i32], caps: &[usize]) -> bool {
-    for b in (0..k.len()).rev() {
-        if k[b] < caps[b] as i32 {
-            k[b] += 1;
-            return true;
-        }
-        k[b] = -(caps[b] as i32);
+/// Every `k` with `|k_b| <= caps[b]` from base `b` on and `Σ_{i >= b} |k_i| <= budget`, the
+/// entries before `b` as in `k`, into `out`: the diamond without walking its box.
+fn enumerate(caps: &[usize], budget: usize, k: &mut Index, b: usize, out: &mut Vec<Index>) {
+    if b == caps.len() {
+        out.push(*k);
+        return;
     }
-    false
+    let reach = caps[b].min(budget) as i32;
+    for v in -reach..=reach {
+        k[b] = v;
+        enumerate(caps, budget - v.unsigned_abs() as usize, k, b + 1, out);
+    }
+    k[b] = 0;
 }
 
 /// The number of `k ∈ Z^d` with `Σ|k_b| <= h` (an upper bound inside a box).

@@ -49,7 +49,7 @@ impl NewtonKrylov {
     /// lower the residual after 12 halvings ends the run, marked not converged.
     pub fn solve(&self, hb: &TorusBalance, start: Option<&[Complex64]>) -> Result<TorusSolution> {
         let mut ws = hb.workspace();
-        let mut u = start.map_or_else(|| hb.linear_start(), <[Complex64]>::to_vec);
+        let mut u = start_of(hb, start)?;
         let len = hb.len();
         let (mut iterations, mut linear) = (0, 0);
         let mut r = vec![Complex64::default(); len];
@@ -113,6 +113,20 @@ impl NewtonKrylov {
             self.max_linear,
         )
         .iterations
+    }
+}
+
+/// The unknowns to start from: `start`, or the linear response; an error for a start of
+/// another length than the balance's unknowns.
+pub(super) fn start_of(hb: &TorusBalance, start: Option<&[Complex64]>) -> Result<Vec<Complex64>> {
+    match start {
+        None => Ok(hb.linear_start()),
+        Some(s) if s.len() == hb.len() => Ok(s.to_vec()),
+        Some(s) => Err(crate::Error::DimensionMismatch {
+            context: "torus start (lines × element coordinates)".into(),
+            expected: hb.len().to_string(),
+            got: s.len().to_string(),
+        }),
     }
 }
 

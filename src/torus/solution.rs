@@ -59,8 +59,8 @@ impl TorusSolution {
         Complex64::default()
     }
 
-    /// `q_dof(t)` on the line `θ_b = ω_b t + φ_b` of the torus (`phases` one per base; the
-    /// phase of a base is where its angle starts, a mesh phasing).
+    /// `q_dof(t)` on the line `θ_b = ω_b t + φ_b` of the torus (`phases` one per base, the
+    /// missing ones 0; the phase of a base is where its angle starts, a mesh phasing).
     pub fn value(&self, dof: usize, t: f64, phases: &[f64]) -> f64 {
         let n = self.n_dofs();
         self.indices
@@ -70,8 +70,11 @@ impl TorusSolution {
                 let angle: f64 = k
                     .iter()
                     .zip(&self.ratios)
-                    .zip(phases)
-                    .map(|((&kb, r), p)| kb as f64 * (r * self.omega * t + p))
+                    .enumerate()
+                    .map(|(b, (&kb, r))| {
+                        let phase = phases.get(b).copied().unwrap_or(0.0);
+                        kb as f64 * (r * self.omega * t + phase)
+                    })
                     .sum();
                 let (re, im) = self.harmonics[j * n + dof];
                 (Complex64::new(re, im) * Complex64::from_polar(1.0, angle)).re

@@ -483,3 +483,147 @@ fn fixed_point_agrees_with_newton_krylov() {
         .to_string()
         .contains("`gamma`"));
 }
+
+/// Review findings: a cosine mesh bound to a base whose axis is not the grid's last sees
+/// angles that repeat along the other axes (the batch evaluation must not take them for
+/// equidistant ones): the torus equals the one-frequency engine on that base to 1e-12, on
+/// every axis of a 3-base torus with odd and even grid sizes.
+#[test]
+fn a_mesh_on_any_axis_equals_the_one_frequency_engine() {
+    let mesh = || {
+        MeshStiffness::new(
+            1,
+            MeshProfile::Cosine {
+                mean: 2.0,
+                amplitude: 0.6,
+            },
+            MeshDamping::Proportional(0.02),
+        )
+    };
+    let model = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .stiffness_triplets(&[(0, 0, 1.0)])
+        .damping_triplets(&[(0, 0, 0.05)])
+        .element("mesh", &[("x", 1.0)], mesh())
+        .load("x", 0, 0.5, 0.0)
+        .load("x", 1, 0.3, 0.1)
+        .build()
+        .unwrap();
+    let ratios = [1.0, 2f64.sqrt(), 3f64.sqrt()];
+    let omega = 0.9;
+    for on in 0..3 {
+        let hb1 = HarmonicBalance::new(
+            &model,
+            HarmonicBasis::new(omega * ratios[on], 2)
+                .unwrap()
+                .with_samples(6)
+                .unwrap(),
+        )
+        .unwrap();
+        let one = hbal::Newton::new()
+            .with_tolerance(1e-13)
+            .unwrap()
+            .solve(&hb1, &mut hb1.workspace())
+            .unwrap();
+        let bases = Bases::new(&[("a", ratios[0]), ("b", ratios[1]), ("c", ratios[2])]).unwrap();
+        let name = ["a", "b", "c"][on];
+        let tm = TorusModel::new(&model, bases)
+            .bind_element("mesh", name)
+            .unwrap()
+            .bind_load(1, name)
+            .unwrap();
+        let mut caps = [1, 1, 1];
+        caps[on] = 2;
+        let set = IndexSet::new(tm.bases(), &caps, Truncation::Box).unwrap();
+        let mut grid = [3, 5, 5];
+        grid[on] = 6;
+        let hb = TorusBalance::new(tm, set, &grid, omega).unwrap();
+        let sol = NewtonKrylov::default().solve(&hb, None).unwrap();
+        assert!(sol.converged);
+        for h in 0..=2 {
+            let mut k = [0i32; 3];
+            k[on] = h;
+            let (a, b) = (sol.harmonic(0, &k), one.harmonic(0, h as usize));
+            assert!(
+                (a - b).norm() < 1e-12 * (1.0 + b.norm()),
+                "base {name}, harmonic {h}: {a} vs {b}"
+            );
+        }
+    }
+}
+
+/// Review findings: a free-free model whose static load follows the speed is checked for
+/// balance at every speed of a sweep, not only at the first; a diamond with large caps is
+/// enumerated without walking its box; a start of the wrong length, a set built for other
+/// bases and a mesh order outside a diamond are errors; missing phases are 0.
+#[test]
+fn review_findings_are_errors_not_silent_answers() {
+    let law = hbal::model::SpeedLaw::power(2.0, 1000.0);
+    let rpm = |x: f64| x * std::f64::consts::TAU / 60.0;
+    let free = Model::builder(&["a", "b"])
+        .mass_diagonal(&[1.0, 2.0])
+        .stiffness_triplets(&[(0, 0, 5.0), (0, 1, -5.0), (1, 0, -5.0), (1, 1, 5.0)])
+        .damping_triplets(&[(0, 0, 0.1), (0, 1, -0.1), (1, 0, -0.1), (1, 1, 0.1)])
+        .element(
+            "c",
+            &[("a", 1.0), ("b", -1.0)],
+            hbal::force::CubicSpring::new(1.0, 0.1),
+        )
+        .load_over_speed("a", 0, 10.0, 0.0, law)
+        .load("b", 0, -10.0, 0.0)
+        .load("a", 1, 1.0, 0.0)
+        .build()
+        .unwrap();
+    let bases = Bases::new(&[("a", 1.0), ("b", 2f64.sqrt())]).unwrap();
+    let set = IndexSet::new(&bases, &[2, 2], Truncation::Box).unwrap();
+    let tm = TorusModel::new(&free, bases.clone());
+    let mut hb = TorusBalance::new(tm.clone(), set.clone(), &[8, 8], rpm(1000.0)).unwrap();
+    let err = hb.set_omega(rpm(2000.0)).unwrap_err().to_string();
+    assert!(err.contains("do not balance"), "{err}");
+    assert_eq!(hb.omega(), rpm(1000.0));
+    // Wrong start length.
+    let err = NewtonKrylov::default().solve(&hb, Some(&[Complex64::default()]));
+    assert!(err.unwrap_err().to_string().contains("torus start"));
+    // A set of other bases.
+    let other = Bases::new(&[("a", 1.0), ("b", 3f64.sqrt())]).unwrap();
+    let set2 = IndexSet::new(&other, &[2, 2], Truncation::Box).unwrap();
+    let err = TorusBalance::new(tm, set2, &[8, 8], rpm(1000.0))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("built for bases"), "{err}");
+    // A diamond of huge caps and degree 2: 13 points, at once.
+    let t = std::time::Instant::now();
+    let three = Bases::new(&[("a", 1.0), ("b", 2f64.sqrt()), ("c", 3f64.sqrt())]).unwrap();
+    let d = IndexSet::new(
+        &three,
+        &[4000, 4000, 4000],
+        Truncation::Diamond { total: 2 },
+    )
+    .unwrap();
+    assert_eq!(d.len(), 13);
+    assert!(t.elapsed().as_secs_f64() < 1.0);
+    // Missing phases are 0.
+    let sol = NewtonKrylov::default().solve(&hb, None).unwrap();
+    assert_eq!(sol.value(0, 0.3, &[]), sol.value(0, 0.3, &[0.0, 0.0]));
+    // A mesh varying at order 3 of its base, outside a diamond of total 2 (caps 3).
+    let mesh = Model::builder(&["x"])
+        .mass_diagonal(&[1.0])
+        .element(
+            "mesh",
+            &[("x", 1.0)],
+            MeshStiffness::new(
+                3,
+                MeshProfile::Cosine {
+                    mean: 1.0,
+                    amplitude: 0.1,
+                },
+                MeshDamping::Proportional(0.01),
+            ),
+        )
+        .load("x", 1, 1.0, 0.0)
+        .build()
+        .unwrap();
+    let set3 = IndexSet::new(&bases, &[3, 3], Truncation::Diamond { total: 2 }).unwrap();
+    let err = TorusBalance::new(TorusModel::new(&mesh, bases), set3, &[8, 8], 1.0).unwrap_err();
+    assert!(err.to_string().contains("does not hold that line"), "{err}");
+}
