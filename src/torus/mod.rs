@@ -40,6 +40,7 @@
 //! assert_eq!((lines[0].0.as_slice(), lines[1].0.as_slice()), (&[1, 0][..], &[0, 1][..]));
 //! ```
 
+mod anderson;
 mod balance;
 mod bases;
 mod elements;
@@ -54,6 +55,7 @@ mod newton_krylov;
 mod solution;
 mod sweep;
 
+pub use anderson::TorusAnderson;
 pub use balance::{TorusBalance, TorusWorkspace};
 pub use bases::Bases;
 pub use fixed_point::TorusFixedPoint;

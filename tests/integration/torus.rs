@@ -5,8 +5,8 @@
 use hbal::force::{Backlash, Flank, ForceLaw, MeshDamping, MeshProfile, MeshStiffness};
 use hbal::num_complex::Complex64;
 use hbal::torus::{
-    Bases, IndexSet, NewtonKrylov, TorusBalance, TorusFixedPoint, TorusModel, TorusStability,
-    TorusSweep, Truncation,
+    Bases, IndexSet, NewtonKrylov, TorusAnderson, TorusBalance, TorusFixedPoint, TorusModel,
+    TorusStability, TorusSweep, Truncation,
 };
 use hbal::{Anderson, Formulation, HarmonicBalance, HarmonicBasis, Model};
 
@@ -452,11 +452,13 @@ fn bad_input_is_refused_by_name() {
     );
 }
 
-/// The paper's fixed point on the torus reaches the Newton–Krylov solution of the rippled
-/// train (contact closed) to 1e-9 of the TE; a relaxation outside (0, 1] is refused.
+/// The paper's fixed point and its Anderson acceleration on the torus reach the Newton–Krylov
+/// solution of the rattling train (the contact opens) to 1e-9, Anderson in fewer iterations
+/// (measured 16 against 20; Newton–Krylov takes 4 steps); a
+/// relaxation outside (0, 1] and a depth of 0 are refused.
 #[test]
 fn fixed_point_agrees_with_newton_krylov() {
-    let model = two_stage_rippled([1, 1], 1, 400.0);
+    let model = two_stage_rippled([1, 1], 1, 1000.0);
     let bases = Bases::new(&[("mesh 1", 67.0), ("mesh 2", 19.0)]).unwrap();
     let tm = TorusModel::new(&model, bases)
         .bind_element("stage 2", "mesh 2")
@@ -482,6 +484,36 @@ fn fixed_point_agrees_with_newton_krylov() {
         .unwrap_err()
         .to_string()
         .contains("`gamma`"));
+    // Anderson: the same solution in fewer iterations.
+    let anderson = TorusAnderson::default().solve(&hb, None).unwrap();
+    assert!(anderson.converged, "{}", anderson.relative_residual);
+    assert!(
+        anderson.iterations < fixed.iterations,
+        "{} vs {}",
+        anderson.iterations,
+        fixed.iterations
+    );
+    eprintln!(
+        "fixed point {} iterations, Anderson {}",
+        fixed.iterations, anderson.iterations
+    );
+    let diff = newton
+        .unknowns
+        .iter()
+        .zip(&anderson.unknowns)
+        .skip(2)
+        .map(|(a, b)| (a.0 - b.0).hypot(a.1 - b.1))
+        .fold(0.0, f64::max);
+    assert!(diff <= 1e-9 * size, "{diff:e} of {size:e}");
+    let bad = TorusAnderson {
+        depth: 0,
+        ..Default::default()
+    };
+    assert!(bad
+        .solve(&hb, None)
+        .unwrap_err()
+        .to_string()
+        .contains("`depth`"));
 }
 
 /// Review findings: a cosine mesh bound to a base whose axis is not the grid's last sees
