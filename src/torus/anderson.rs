@@ -8,6 +8,7 @@
 //! complex-linear). Same cost per iteration as the fixed point, far fewer iterations where the
 //! rest is not weak.
 
+use super::fixed_point::{receptance_step, Watch};
 use super::newton_krylov::{finish, relative_residual, start_of};
 use super::{TorusBalance, TorusSolution};
 use crate::error::{Error, Result};
@@ -59,36 +60,23 @@ impl TorusAnderson {
         }
         let mut ws = hb.workspace();
         let mut u = start_of(hb, start)?;
-        let (len, m) = (hb.len(), hb.coordinates());
+        let len = hb.len();
         if len == 0 {
             return finish(hb, &u, &mut ws, 0.0, true, 0, 0);
         }
         let mut r = vec![Complex64::default(); len];
         let mut f = vec![Complex64::default(); len];
-        let (mut best, mut best_u) = (f64::INFINITY, u.clone());
+        let mut watch = Watch::new(&u, self.tolerance, self.max_iterations);
         let mut history: VecDeque<(DVector<f64>, DVector<f64>)> = VecDeque::new();
         let mut last: Option<(DVector<f64>, DVector<f64>)> = None;
-        let (mut iterations, mut converged) = (0, false);
-        loop {
+        let mut iterations = 0;
+        let converged = loop {
             hb.residual_into(&u, &mut r, false, &mut ws)?;
-            let relative = relative_residual(hb, &u, &r);
-            if relative < best {
-                (best, best_u) = (relative, u.clone());
-            }
-            if relative <= self.tolerance {
-                converged = true;
-                break;
-            }
-            if iterations >= self.max_iterations || !relative.is_finite() || relative > 1e3 * best {
-                break;
+            if let Some(converged) = watch.observe(&u, relative_residual(hb, &u, &r), iterations) {
+                break converged;
             }
             iterations += 1;
-            for (j, g) in hb.linear.receptance.iter().enumerate() {
-                for a in 0..m {
-                    let s: Complex64 = (0..m).map(|b| g[(a, b)] * r[j * m + b]).sum();
-                    f[j * m + a] = -s * self.gamma;
-                }
-            }
+            receptance_step(hb, &r, self.gamma, &mut f);
             let (uk, fk) = (real(&u), real(&f));
             if let Some((u0, f0)) = last.take() {
                 history.push_back((&uk - u0, &fk - f0));
@@ -110,7 +98,15 @@ impl TorusAnderson {
                 *v = Complex64::new(next[2 * j], next[2 * j + 1]);
             }
             last = Some((uk, fk));
-        }
-        finish(hb, &best_u, &mut ws, best, converged, iterations, 0)
+        };
+        finish(
+            hb,
+            &watch.best_u,
+            &mut ws,
+            watch.best,
+            converged,
+            iterations,
+            0,
+        )
     }
 }

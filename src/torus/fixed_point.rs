@@ -48,35 +48,91 @@ impl TorusFixedPoint {
         }
         let mut ws = hb.workspace();
         let mut u = start_of(hb, start)?;
-        let (len, m) = (hb.len(), hb.coordinates());
-        let mut r = vec![Complex64::default(); len];
-        let (mut best, mut best_u) = (f64::INFINITY, u.clone());
-        let mut iterations = 0;
-        let mut converged = false;
+        let len = hb.len();
         if len == 0 {
             return finish(hb, &u, &mut ws, 0.0, true, 0, 0);
         }
-        loop {
+        let (mut r, mut f) = (
+            vec![Complex64::default(); len],
+            vec![Complex64::default(); len],
+        );
+        let mut watch = Watch::new(&u, self.tolerance, self.max_iterations);
+        let mut iterations = 0;
+        let converged = loop {
             hb.residual_into(&u, &mut r, false, &mut ws)?;
-            let relative = relative_residual(hb, &u, &r);
-            if relative < best {
-                (best, best_u) = (relative, u.clone());
-            }
-            if relative <= self.tolerance {
-                converged = true;
-                break;
-            }
-            if iterations >= self.max_iterations || !relative.is_finite() || relative > 1e3 * best {
-                break;
+            if let Some(converged) = watch.observe(&u, relative_residual(hb, &u, &r), iterations) {
+                break converged;
             }
             iterations += 1;
-            for (j, g) in hb.linear.receptance.iter().enumerate() {
-                for a in 0..m {
-                    let step: Complex64 = (0..m).map(|b| g[(a, b)] * r[j * m + b]).sum();
-                    u[j * m + a] -= step * self.gamma;
-                }
+            receptance_step(hb, &r, self.gamma, &mut f);
+            for (x, s) in u.iter_mut().zip(&f) {
+                *x += s;
             }
+        };
+        finish(
+            hb,
+            &watch.best_u,
+            &mut ws,
+            watch.best,
+            converged,
+            iterations,
+            0,
+        )
+    }
+}
+
+/// `out ← -γ G R` per line: the fixed point's step.
+pub(super) fn receptance_step(
+    hb: &TorusBalance,
+    r: &[Complex64],
+    gamma: f64,
+    out: &mut [Complex64],
+) {
+    let m = hb.coordinates();
+    for (j, g) in hb.linear.receptance.iter().enumerate() {
+        for a in 0..m {
+            let s: Complex64 = (0..m).map(|b| g[(a, b)] * r[j * m + b]).sum();
+            out[j * m + a] = -s * gamma;
         }
-        finish(hb, &best_u, &mut ws, best, converged, iterations, 0)
+    }
+}
+
+/// The best iterate of a fixed-point-type run, and when it stops: at the tolerance, the
+/// iteration limit, or divergence (a residual a thousand times the smallest seen, or not
+/// finite).
+pub(super) struct Watch {
+    pub(super) best: f64,
+    pub(super) best_u: Vec<Complex64>,
+    tolerance: f64,
+    max_iterations: usize,
+}
+
+impl Watch {
+    pub(super) fn new(u: &[Complex64], tolerance: f64, max_iterations: usize) -> Self {
+        Self {
+            best: f64::INFINITY,
+            best_u: u.to_vec(),
+            tolerance,
+            max_iterations,
+        }
+    }
+
+    /// Records `u` with its relative residual after `iterations`; `Some(converged)` where the
+    /// run stops.
+    pub(super) fn observe(
+        &mut self,
+        u: &[Complex64],
+        relative: f64,
+        iterations: usize,
+    ) -> Option<bool> {
+        if relative < self.best {
+            self.best = relative;
+            self.best_u.copy_from_slice(u);
+        }
+        if relative <= self.tolerance {
+            return Some(true);
+        }
+        let diverged = !relative.is_finite() || relative > 1e3 * self.best;
+        (iterations >= self.max_iterations || diverged).then_some(false)
     }
 }
