@@ -113,30 +113,33 @@ impl MeshProfile {
     pub fn values_into(&self, z: f64, phase: f64, theta: &[f64], out: &mut [f64]) {
         debug_assert!(theta.len() <= 64 && out.len() >= theta.len());
         let n = theta.len();
-        // Only angles that step uniformly (every step, not just the ends: the torus AFT
-        // passes angles that repeat along the other bases' axes) take the shortcuts.
-        let step = uniform_step(theta);
-        if let (MeshProfile::Sampled(table), Some(step)) = (self, step) {
+        if let MeshProfile::Sampled(table) = self {
             // The AFT's own consecutive samples: one lookup, then a copy.
-            if table.is_table_step(z * step)
-                && table.copy_run(
-                    z * theta[0] + phase,
-                    z * theta[n - 1] + phase,
-                    &mut out[..n],
-                )
-            {
+            if table.copy_run(
+                z * theta[0] + phase,
+                z * theta[n - 1] + phase,
+                &mut out[..n],
+            ) {
                 return;
             }
         }
-        if let (MeshProfile::Cosine { mean, amplitude }, Some(step)) = (self, step) {
-            let (s0, c0) = (z * theta[0] + phase).sin_cos();
-            let (sd, cd) = (z * step).sin_cos();
-            let (mut c, mut s) = (c0, s0);
-            for o in out[..n].iter_mut() {
-                *o = mean + amplitude * c;
-                (c, s) = (c * cd - s * sd, s * cd + c * sd);
+        if let (MeshProfile::Cosine { mean, amplitude }, true) = (self, n > 2) {
+            let step = theta[1] - theta[0];
+            // Rising angles whose ends agree with a uniform step (the AFT's own samples; the
+            // torus passes each base's angles line by line, so never repeated angles).
+            let uniform = step > 0.0
+                && (theta[n - 1] - theta[0] - (n - 1) as f64 * step).abs()
+                    <= 1e-12 * theta[n - 1].abs().max(1.0);
+            if uniform {
+                let (s0, c0) = (z * theta[0] + phase).sin_cos();
+                let (sd, cd) = (z * step).sin_cos();
+                let (mut c, mut s) = (c0, s0);
+                for o in out[..n].iter_mut() {
+                    *o = mean + amplitude * c;
+                    (c, s) = (c * cd - s * sd, s * cd + c * sd);
+                }
+                return;
             }
-            return;
         }
         for (o, t) in out[..n].iter_mut().zip(theta) {
             *o = self.value(z * t + phase);
@@ -413,18 +416,4 @@ pub(crate) fn jump_angles(jumps: &[f64], teeth: u32, phase: f64) -> Vec<f64> {
     }
     out.sort_by(f64::total_cmp);
     out
-}
-
-/// The step of `theta` where there are at least three angles and every step is the same
-/// positive one (to 1e-12 of the angles' size); `None` otherwise.
-fn uniform_step(theta: &[f64]) -> Option<f64> {
-    if theta.len() < 3 {
-        return None;
-    }
-    let step = theta[1] - theta[0];
-    let uniform = step > 0.0
-        && theta
-            .windows(2)
-            .all(|w| (w[1] - w[0] - step).abs() <= 1e-12 * w[1].abs().max(1.0));
-    uniform.then_some(step)
 }

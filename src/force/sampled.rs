@@ -67,12 +67,6 @@ impl SampledProfile {
         ((x - i).abs() <= 1e-7).then(|| (i as i64).rem_euclid(n as i64) as usize)
     }
 
-    /// Whether `step` (a mesh angle) is one step of the table.
-    pub(super) fn is_table_step(&self, step: f64) -> bool {
-        let table = self.teeth * TAU / self.values.len() as f64;
-        (step - table).abs() <= 1e-9 * table
-    }
-
     /// `out[j] = k` at `out.len()` consecutive tabulated angles from `first` to `last`, if they
     /// are (a copy of the table, wrapping at its end); `false` otherwise.
     pub(super) fn copy_run(&self, first: f64, last: f64, out: &mut [f64]) -> bool {

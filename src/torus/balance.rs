@@ -31,6 +31,8 @@ pub struct TorusBalance<'m> {
     active: Vec<TorusElement>,
     /// Per base, its angle at every grid point.
     thetas: Vec<Vec<f64>>,
+    /// Per base, its `N_b` sample angles `2π j / N_b` (one grid line along it).
+    line_thetas: Vec<Vec<f64>>,
     pub(super) dense: crate::model::DenseMatrices,
     pub(super) augmentation: Option<DMatrix<f64>>,
     /// The rigid-body modes of a free-free model, whose mean loads must balance at every speed.
@@ -56,6 +58,8 @@ pub struct TorusWorkspace {
     /// with derivatives.
     pub(super) gu: Vec<Vec<f64>>,
     pub(super) gdu: Vec<Vec<f64>>,
+    /// One grid line along a base: `u`, `u̇` and the law's values there.
+    lines: [Vec<f64>; 4],
     /// Transforms done.
     pub ffts: usize,
 }
@@ -94,6 +98,11 @@ impl<'m> TorusBalance<'m> {
                     .collect()
             })
             .collect();
+        let line_thetas = fft
+            .dims()
+            .iter()
+            .map(|&nb| (0..nb).map(|j| TAU * j as f64 / nb as f64).collect())
+            .collect();
         let dense = model.dense("torus harmonic balance")?;
         let w = DMatrix::from_fn(n, coordinates.len(), |i, c| {
             coordinates[c]
@@ -125,6 +134,7 @@ impl<'m> TorusBalance<'m> {
             names,
             active,
             thetas,
+            line_thetas,
             dense,
             augmentation,
             rigid: rigid_modes,
@@ -168,6 +178,9 @@ impl<'m> TorusBalance<'m> {
             gde: grid(),
             gu: vec![grid(); m],
             gdu: vec![grid(); m],
+            lines: std::array::from_fn(|_| {
+                vec![0.0; self.fft.dims().iter().copied().max().unwrap_or(0)]
+            }),
             ffts: 0,
         }
     }
@@ -323,7 +336,7 @@ impl<'m> TorusBalance<'m> {
         for (x, &v) in ws.due.iter_mut().zip(&ws.du[c]) {
             *x = s * v;
         }
-        law.force_batch(theta, &ws.ue, &ws.due, &mut ws.fe);
+        self.law_batches(act.base, law, false, ws);
         let delta = 1e-7 * TAU / self.fft.dims()[act.base] as f64;
         for &p in &act.jumps {
             let (t, x, v) = (theta[p], ws.ue[p], ws.due[p]);
@@ -342,7 +355,7 @@ impl<'m> TorusBalance<'m> {
             *acc += s * rest;
         }
         if derivatives {
-            law.derivatives_batch(theta, &ws.ue, &ws.due, &mut ws.ge, &mut ws.gde);
+            self.law_batches(act.base, law, true, ws);
             for &p in &act.jumps {
                 let (t, x, v) = (theta[p], ws.ue[p], ws.due[p]);
                 let (a0, b0) = law.derivatives(t - delta, x, v);
@@ -362,6 +375,46 @@ impl<'m> TorusBalance<'m> {
             }
         }
         Ok(())
+    }
+
+    /// The law's force at every grid point into `ws.fe` (or its derivatives into `ws.ge`,
+    /// `ws.gde`), from `ws.ue`, `ws.due`, evaluated line by line along the base's own axis: every
+    /// batch a law sees is its base's equidistant angles in order, never the angles repeated
+    /// along the other axes (a law may take a shortcut on equidistant angles, as
+    /// [`MeshProfile::values_into`](crate::force::MeshProfile::values_into) does).
+    #[allow(clippy::needless_range_loop)] // j indexes the line and, through `at`, the grid
+    fn law_batches(
+        &self,
+        base: usize,
+        law: &dyn crate::force::ForceLaw,
+        derivatives: bool,
+        ws: &mut TorusWorkspace,
+    ) {
+        let dims = self.fft.dims();
+        let (n, stride) = (dims[base], dims[base + 1..].iter().product::<usize>());
+        let theta = &self.line_thetas[base];
+        let lines = &mut ws.lines;
+        for o in 0..self.fft.points() / (n * stride) {
+            for i in 0..stride {
+                let at = |j: usize| o * n * stride + j * stride + i;
+                for j in 0..n {
+                    (lines[0][j], lines[1][j]) = (ws.ue[at(j)], ws.due[at(j)]);
+                }
+                let [u, du, f, g, ..] = lines;
+                let (u, du) = (&u[..n], &du[..n]);
+                if derivatives {
+                    law.derivatives_batch(theta, u, du, &mut f[..n], &mut g[..n]);
+                    for j in 0..n {
+                        (ws.ge[at(j)], ws.gde[at(j)]) = (f[j], g[j]);
+                    }
+                } else {
+                    law.force_batch(theta, u, du, &mut f[..n]);
+                    for j in 0..n {
+                        ws.fe[at(j)] = f[j];
+                    }
+                }
+            }
+        }
     }
 
     /// Samples of coordinate c of `u` (or of its time derivative) into `out`.
