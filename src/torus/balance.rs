@@ -29,8 +29,6 @@ pub struct TorusBalance<'m> {
     coordinates: Vec<Vec<(usize, f64)>>,
     names: Vec<String>,
     active: Vec<TorusElement>,
-    /// Per base, its angle at every grid point.
-    thetas: Vec<Vec<f64>>,
     /// Per base, its `N_b` sample angles `2π j / N_b` (one grid line along it).
     line_thetas: Vec<Vec<f64>>,
     pub(super) dense: crate::model::DenseMatrices,
@@ -85,19 +83,9 @@ impl<'m> TorusBalance<'m> {
         crate::harmonic::HarmonicBasis::new(omega, 0)?;
         model.check_load_speeds(omega, omega)?;
         let fft = TorusFft::new(&set, samples)?;
-        let (n, d) = (model.n_dofs(), set.dims());
+        let n = model.n_dofs();
         let f_full = full_load(&tm, &set, omega)?;
         let (active, coordinates, names) = active_elements(&tm, &set, fft.dims())?;
-        let points = fft.points();
-        let thetas = (0..d)
-            .map(|b| {
-                let stride: usize = fft.dims()[b + 1..].iter().product();
-                let nb = fft.dims()[b];
-                (0..points)
-                    .map(|p| TAU * ((p / stride) % nb) as f64 / nb as f64)
-                    .collect()
-            })
-            .collect();
         let line_thetas = fft
             .dims()
             .iter()
@@ -133,7 +121,6 @@ impl<'m> TorusBalance<'m> {
             coordinates,
             names,
             active,
-            thetas,
             line_thetas,
             dense,
             augmentation,
@@ -240,7 +227,7 @@ impl<'m> TorusBalance<'m> {
     pub fn linear_start(&self) -> Vec<Complex64> {
         let m = self.coordinates();
         let mut u = Vec::with_capacity(self.len());
-        for (j, x) in self.linear.solved.iter().enumerate() {
+        for x in &self.linear.solved {
             for c in 0..m {
                 u.push(
                     self.coordinates[c]
@@ -249,7 +236,6 @@ impl<'m> TorusBalance<'m> {
                         .sum(),
                 );
             }
-            let _ = j;
         }
         u
     }
@@ -329,7 +315,10 @@ impl<'m> TorusBalance<'m> {
         let e = &self.tm.model().elements()[act.index];
         let law = act.band_limited.as_deref().unwrap_or(e.law());
         let (c, s, lin) = (act.coordinate, act.factor, act.linear);
-        let theta = &self.thetas[act.base];
+        // The base's angle at grid point p (for the samples on the law's time jumps).
+        let (n, stride) = self.axis(act.base);
+        let line = &self.line_thetas[act.base];
+        let theta = |p: usize| line[(p / stride) % n];
         for (x, &v) in ws.ue.iter_mut().zip(&ws.u[c]) {
             *x = s * v;
         }
@@ -339,7 +328,7 @@ impl<'m> TorusBalance<'m> {
         self.law_batches(act.base, law, false, ws);
         let delta = 1e-7 * TAU / self.fft.dims()[act.base] as f64;
         for &p in &act.jumps {
-            let (t, x, v) = (theta[p], ws.ue[p], ws.due[p]);
+            let (t, x, v) = (theta(p), ws.ue[p], ws.due[p]);
             ws.fe[p] = 0.5 * (law.force(t - delta, x, v) + law.force(t + delta, x, v));
         }
         for (((f, &x), &v), acc) in ws.fe.iter().zip(&ws.ue).zip(&ws.due).zip(&mut ws.force[c]) {
@@ -357,7 +346,7 @@ impl<'m> TorusBalance<'m> {
         if derivatives {
             self.law_batches(act.base, law, true, ws);
             for &p in &act.jumps {
-                let (t, x, v) = (theta[p], ws.ue[p], ws.due[p]);
+                let (t, x, v) = (theta(p), ws.ue[p], ws.due[p]);
                 let (a0, b0) = law.derivatives(t - delta, x, v);
                 let (a1, b1) = law.derivatives(t + delta, x, v);
                 (ws.ge[p], ws.gde[p]) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
@@ -390,8 +379,7 @@ impl<'m> TorusBalance<'m> {
         derivatives: bool,
         ws: &mut TorusWorkspace,
     ) {
-        let dims = self.fft.dims();
-        let (n, stride) = (dims[base], dims[base + 1..].iter().product::<usize>());
+        let (n, stride) = self.axis(base);
         let theta = &self.line_thetas[base];
         let lines = &mut ws.lines;
         for o in 0..self.fft.points() / (n * stride) {
@@ -415,6 +403,12 @@ impl<'m> TorusBalance<'m> {
                 }
             }
         }
+    }
+
+    /// The samples `N_b` of base b's axis and its stride in the grid.
+    fn axis(&self, base: usize) -> (usize, usize) {
+        let dims = self.fft.dims();
+        (dims[base], dims[base + 1..].iter().product())
     }
 
     /// Samples of coordinate c of `u` (or of its time derivative) into `out`.

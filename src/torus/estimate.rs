@@ -86,19 +86,9 @@ impl TorusBalance<'_> {
     /// `G(ν) = Wᵀ Z(ν)⁻¹ W` at a line outside the set (zeros where `Z(ν)` is singular: a
     /// line on an undamped resonance has no finite first-order response to estimate).
     fn receptance(&self, nu: f64) -> DMatrix<Complex64> {
-        let (dense, w) = (&self.dense, &self.w);
-        let n = w.nrows();
-        let mut z = DMatrix::from_fn(n, n, |a, b| {
-            Complex64::new(
-                dense.k0[(a, b)] - nu * nu * dense.mass[(a, b)],
-                nu * dense.d0[(a, b)] + dense.hysteretic[(a, b)],
-            )
-        });
-        if nu == 0.0 {
-            if let Some(a) = &self.augmentation {
-                z += a.map(|v| Complex64::new(v, 0.0));
-            }
-        }
+        let w = &self.w;
+        let aug = self.augmentation.as_ref().filter(|_| nu == 0.0);
+        let (z, _) = super::linear::dynamic_stiffness(&self.dense, nu, aug);
         let wc = w.map(|v| Complex64::new(v, 0.0));
         match z.lu().solve(&wc) {
             Some(x) => wc.transpose() * x,

@@ -43,31 +43,13 @@ impl TorusLinear {
     ) -> Result<Self> {
         let (n, m) = (w.nrows(), w.ncols());
         let wc = w.map(|v| Complex64::new(v, 0.0));
-        let hysteretic = dense.hysteretic.amax() > 0.0;
         let mut solved = Vec::with_capacity(set.len());
         let mut stiffness = Vec::with_capacity(set.len());
         let mut receptance = Vec::with_capacity(set.len());
         let mut load = Vec::with_capacity(set.len() * m);
         for j in 0..set.len() {
             let nu = omega * set.ratio(j);
-            let mut z = DMatrix::from_fn(n, n, |a, b| {
-                Complex64::new(
-                    dense.k0[(a, b)] - nu * nu * dense.mass[(a, b)],
-                    nu * dense.d0[(a, b)],
-                )
-            });
-            let mut scale = dense
-                .k0
-                .amax()
-                .max(nu * nu * dense.mass.amax())
-                .max(nu * dense.d0.amax());
-            if let (0, Some(a)) = (j, augmentation) {
-                z += a.map(|v| Complex64::new(v, 0.0));
-            }
-            if j > 0 && hysteretic {
-                z += dense.hysteretic.map(|v| Complex64::new(0.0, v));
-                scale = scale.max(dense.hysteretic.amax());
-            }
+            let (z, scale) = dynamic_stiffness(dense, nu, augmentation.filter(|_| j == 0));
             let lu = z.lu();
             check_pivots(lu.u().diagonal().iter().map(|p| p.norm()), scale, || {
                 singular(set, j, nu)
@@ -139,6 +121,35 @@ impl TorusLinear {
         }
         out
     }
+}
+
+/// `Z(ν) = -ν² M + i ν D0 + K0`, with `+ i H` at `ν > 0` and `augmentation` added where given
+/// (the static line of a free-free model), and the scale of its entries for the pivot test.
+pub(super) fn dynamic_stiffness(
+    dense: &DenseMatrices,
+    nu: f64,
+    augmentation: Option<&DMatrix<f64>>,
+) -> (DMatrix<Complex64>, f64) {
+    let n = dense.mass.nrows();
+    let mut z = DMatrix::from_fn(n, n, |a, b| {
+        Complex64::new(
+            dense.k0[(a, b)] - nu * nu * dense.mass[(a, b)],
+            nu * dense.d0[(a, b)],
+        )
+    });
+    let mut scale = dense
+        .k0
+        .amax()
+        .max(nu * nu * dense.mass.amax())
+        .max(nu * dense.d0.amax());
+    if let Some(a) = augmentation {
+        z += a.map(|v| Complex64::new(v, 0.0));
+    }
+    if nu > 0.0 && dense.hysteretic.amax() > 0.0 {
+        z += dense.hysteretic.map(|v| Complex64::new(0.0, v));
+        scale = scale.max(dense.hysteretic.amax());
+    }
+    (z, scale)
 }
 
 /// An error from `err` where the smallest pivot is at most [`SINGULAR_PIVOT`] of `scale`.
