@@ -53,6 +53,8 @@ mod sweep;
 mod sweep_outcome;
 mod sweep_record;
 mod sweep_settings;
+mod torus_lines;
+mod torus_solve;
 
 pub use branch_outputs::{contact_loss, point_outputs, ContactLoss};
 pub use compare::{compare, CompareAnalysis, CompareAuto, CompareSettings, MethodComparison};
@@ -70,3 +72,5 @@ pub use sweep::{check_sweep, sweep, SweepAnalysis};
 pub use sweep_outcome::SweepNote;
 pub use sweep_record::SCHEMA_VERSION;
 pub use sweep_settings::{SweepSettings, SweepStart};
+pub use torus_lines::{line_label, LineRecord, Spectrum};
+pub use torus_solve::{torus_solve, BaseRecord, TorusSolveAnalysis, TorusSolveSettings, TOP_LINES};

@@ -16,13 +16,15 @@ fn fail(path: &str, message: String) -> (String, String) {
 }
 
 /// Adds the elements to `builder`; gear stages count their shaft orders against a fundamental
-/// of order `fundamental_order`.
+/// of order `fundamental_order`, or on the torus against their base's order
+/// (`stage_order(name)`).
 pub(super) fn add(
     mut builder: ModelBuilder,
     elements: Vec<Map<String, Value>>,
     dofs: &Dofs,
     known: &HashSet<&str>,
     fundamental_order: f64,
+    stage_order: &dyn Fn(&str) -> Option<f64>,
 ) -> Result<ModelBuilder, (String, String)> {
     for (i, e) in elements.into_iter().enumerate() {
         let at = |field: &str| format!("elements[{i}].{field}");
@@ -34,7 +36,8 @@ pub(super) fn add(
         };
         if e.get("type").and_then(Value::as_str) == Some("gear_stage") {
             e.remove("type");
-            let stage = super::gear_stage::read(e, &name, dofs, fundamental_order, |f| {
+            let order = stage_order(&name).unwrap_or(fundamental_order);
+            let stage = super::gear_stage::read(e, &name, dofs, order, |f| {
                 if f.is_empty() {
                     format!("elements[{i}]")
                 } else {

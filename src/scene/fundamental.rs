@@ -112,7 +112,7 @@ impl Fundamental {
 /// `teeth × shaft_order` of a `gear_stage` table whose stiffness varies with the mesh cycle,
 /// read leniently (the stage's own check reports bad values); `None` for a constant
 /// stiffness, which has no mesh order.
-fn stage_mesh_order(e: &Map<String, Value>) -> Option<f64> {
+pub(super) fn stage_mesh_order(e: &Map<String, Value>) -> Option<f64> {
     if e.get("type").and_then(Value::as_str) != Some("gear_stage") {
         return None;
     }

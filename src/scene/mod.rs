@@ -43,11 +43,13 @@ pub mod matrix_market;
 mod overrides;
 mod paths;
 mod solver;
+mod torus_plan;
 
 pub use overrides::{HarmonicsOverride, Overrides};
 use paths::{field_path, is_json, line_col, non_finite, out_of_range, strip_position};
 use solver::SolverSpec;
 pub use solver::{check_tolerance, MAX_ITERATIONS, METHODS, MIN_TOLERANCE};
+pub use torus_plan::TorusPlan;
 
 use crate::solve::Method;
 use crate::{HarmonicBasis, Model};
@@ -147,6 +149,11 @@ pub struct Scene {
     /// Things the user should know that are not errors (a `loads` order that counts half
     /// orders because the engine table chose the fundamental).
     pub notes: Vec<String>,
+    /// The scene on several base frequencies ([`crate::torus`]), where it is solved there:
+    /// `harmonics.bases = "torus"`, or `"auto"` (the default) where one fundamental cannot
+    /// hold the meshes. `basis` is then the first base's (a placeholder for the one-frequency
+    /// analyses, which refuse such a scene).
+    pub torus: Option<TorusPlan>,
     solver: SolverSpec,
 }
 
@@ -283,9 +290,40 @@ impl SceneFile {
         let fundamental = self
             .fundamental
             .unwrap_or_else(fundamental::Fundamental::placeholder);
-        let speed = fundamental
-            .speed(self.engine.as_ref(), &self.elements)
-            .map_err(|(path, message)| err(&path, message))?;
+        let mut elements = self.elements;
+        let one = fundamental.speed(self.engine.as_ref(), &elements);
+        let meshes = torus_plan::meshes(&elements);
+        let torus_why = self.harmonics.as_ref().and_then(|h| {
+            let kept = if h.auto {
+                h.max
+                    .or(Some(crate::solve::AutoHarmonics::default().max_harmonics))
+            } else {
+                h.count
+            };
+            torus_plan::choose(h.bases, &meshes, &one, kept)
+        });
+        let (speed, layout) = match torus_why {
+            None => (one.map_err(|(path, message)| err(&path, message))?, None),
+            Some(why) => {
+                let f0 = fundamental
+                    .speed(self.engine.as_ref(), &[])
+                    .map_err(|(path, message)| err(&path, message))?;
+                let layout = torus_plan::Layout::new(
+                    &mut elements,
+                    &meshes,
+                    f0.order,
+                    self.engine.is_some(),
+                    why,
+                )
+                .map_err(|(path, message)| err(&path, message))?;
+                (f0, Some(layout))
+            }
+        };
+        if layout.is_none() {
+            if let Some(i) = elements.iter().position(|e| e.contains_key("base")) {
+                return Err(err(&format!("elements[{i}].base"), "binds the element to a base of the torus, but this scene is solved on one fundamental (`harmonics.bases = \"torus\"` puts it on the torus)".into()));
+            }
+        }
         let builder = loads::add(
             builder,
             &self.loads,
@@ -295,7 +333,8 @@ impl SceneFile {
             speed.order,
         )
         .map_err(|(path, message)| err(&path, message))?;
-        let builder = elements::add(builder, self.elements, dofs, &known, speed.order)
+        let stage_order = |name: &str| layout.as_ref().and_then(|l| l.stage_order(name));
+        let builder = elements::add(builder, elements, dofs, &known, speed.order, &stage_order)
             .map_err(|(path, message)| err(&path, message))?;
         let model = builder.build().map_err(|e| {
             let (path, message) = structure.model_error(&e);
@@ -315,9 +354,15 @@ impl SceneFile {
         let harmonics = self
             .harmonics
             .unwrap_or_else(|| harmonics::Harmonics::placeholder(model.max_order().max(1)));
-        let (basis, auto) = harmonics
-            .basis(speed.omega)
+        let torus = layout
+            .map(|l| l.finish(&harmonics, &model, speed.per_unit))
+            .transpose()
             .map_err(|(path, message)| err(&path, message))?;
+        let (basis, auto) = match &torus {
+            None => harmonics.basis(speed.omega),
+            Some(plan) => harmonics.torus_basis(speed.omega, plan.caps[0]),
+        }
+        .map_err(|(path, message)| err(&path, message))?;
         let method = self
             .solver
             .method(None)
@@ -334,6 +379,7 @@ impl SceneFile {
             fundamental_order: speed.order,
             operating_point,
             notes,
+            torus,
             solver: self.solver,
         })
     }
@@ -343,6 +389,12 @@ impl Scene {
     /// An error for `analysis` (`solve`, `sweep`, ...) where the scene gives no operating
     /// point (`fundamental` and `harmonics`).
     pub fn require_operating_point(&self, analysis: &str) -> crate::Result<()> {
+        if let Some(plan) = &self.torus {
+            return Err(crate::Error::InvalidElement {
+                context: format!("`{analysis}`"),
+                reason: format!("runs on one fundamental, and this scene is solved on several base frequencies ({}): `hbal solve` and `hbal sweep` solve it there (crate::analysis::torus_solve, torus_sweep); `harmonics.bases = \"one\"` puts it on one fundamental", plan.why),
+            });
+        }
         if self.operating_point {
             return Ok(());
         }

@@ -63,12 +63,41 @@ pub struct Overrides {
 }
 
 impl Overrides {
+    /// On the torus only the tolerance applies (of Newton–Krylov's relative residual).
+    fn apply_torus(&self, plan: &mut super::TorusPlan) -> Result<()> {
+        let given = [
+            ("--method", self.method.is_some()),
+            ("--harmonics", self.harmonics.is_some()),
+            ("--samples", self.samples.is_some()),
+        ];
+        if let Some((flag, _)) = given.iter().find(|g| g.1) {
+            return Err(Error::InvalidOptions {
+                option: flag.to_string(),
+                reason: format!(
+                    "applies to one fundamental; this scene is solved on several base frequencies ({}): give `harmonics.caps` (or `auto = true`) in the scene, or `harmonics.bases = \"one\"`",
+                    plan.why
+                ),
+            });
+        }
+        if let Some(t) = self.tolerance {
+            super::check_tolerance(t).map_err(|reason| Error::InvalidOptions {
+                option: "--tolerance".into(),
+                reason,
+            })?;
+            plan.tolerance = t;
+        }
+        Ok(())
+    }
+
     /// Applies the overrides to `scene`.
     ///
     /// # Errors
     /// An unknown method, a tolerance out of range or with the exact method, an H or N the
     /// basis refuses ([`Error::InvalidOptions`] naming the option; bad input).
     pub fn apply(&self, scene: &mut Scene) -> Result<()> {
+        if let Some(plan) = &mut scene.torus {
+            return self.apply_torus(plan);
+        }
         if let Some(name) = &self.method {
             scene.method = scene.method_named(name)?;
         }

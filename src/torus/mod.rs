@@ -41,6 +41,7 @@
 //! ```
 
 mod anderson;
+mod auto_caps;
 mod balance;
 mod bases;
 mod elements;
@@ -56,6 +57,7 @@ mod solution;
 mod sweep;
 
 pub use anderson::TorusAnderson;
+pub use auto_caps::{AutoCaps, AutoCapsOutcome, CapsLevel};
 pub use balance::{TorusBalance, TorusWorkspace};
 pub use bases::Bases;
 pub use fixed_point::TorusFixedPoint;

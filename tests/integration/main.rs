@@ -81,4 +81,5 @@ mod stability_worker;
 mod tail_correction;
 mod threads;
 mod torus;
+mod torus_scene;
 mod two_level;

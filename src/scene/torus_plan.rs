@@ -1,0 +1,321 @@
+//! The scene's choice between one fundamental and several base frequencies (a torus,
+//! [`crate::torus`]), and the torus it describes: one base for the engine (or the reference
+//! shaft) and one per gear stage whose mesh stiffness varies, each at its own order of the
+//! speed.
+//!
+//! `harmonics.bases = "auto"` (the default) keeps one fundamental wherever it holds the
+//! meshes, as before, and takes the torus where it cannot: the engine and mesh orders have no
+//! common fundamental, or a mesh's first harmonic lies above the harmonics the scene keeps.
+
+use super::fundamental::Speed;
+use crate::model::Model;
+use crate::torus::{Bases, IndexSet, TorusModel, Truncation};
+use serde::Deserialize;
+use serde_json::{Map, Value};
+
+type FieldError = (String, String);
+
+/// `harmonics.bases`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum BasesChoice {
+    /// One fundamental where it holds every mesh, else the torus.
+    #[default]
+    Auto,
+    /// One fundamental.
+    One,
+    /// A base per engine and varying mesh.
+    Torus,
+}
+
+/// A gear stage with a varying stiffness: where it is, its name and mesh order `z s`.
+#[derive(Debug, Clone)]
+pub(super) struct Mesh {
+    index: usize,
+    name: String,
+    order: f64,
+}
+
+/// The varying gear stages of the raw element tables.
+pub(super) fn meshes(elements: &[Map<String, Value>]) -> Vec<Mesh> {
+    elements
+        .iter()
+        .enumerate()
+        .filter_map(|(i, e)| {
+            let order = super::fundamental::stage_mesh_order(e)?;
+            let name = e
+                .get("name")
+                .and_then(Value::as_str)
+                .map_or_else(|| format!("element {i}"), str::to_string);
+            Some(Mesh {
+                index: i,
+                name,
+                order,
+            })
+        })
+        .collect()
+}
+
+/// Why the scene goes on the torus, or `None` for one fundamental. `one` is the fundamental
+/// every order fits; `harmonics` the H the scene keeps on it (the cap of automatic H).
+pub(super) fn choose(
+    choice: BasesChoice,
+    meshes: &[Mesh],
+    one: &Result<Speed, FieldError>,
+    harmonics: Option<usize>,
+) -> Option<String> {
+    match choice {
+        BasesChoice::One => None,
+        BasesChoice::Torus => Some("harmonics.bases = \"torus\"".into()),
+        BasesChoice::Auto if meshes.is_empty() => None,
+        BasesChoice::Auto => match one {
+            Err(_) => Some(
+                "the engine and mesh orders share no fundamental (none with a denominator up to 1000)"
+                    .into(),
+            ),
+            Ok(speed) => {
+                let h = harmonics?;
+                let worst = meshes
+                    .iter()
+                    .map(|m| (m, (m.order / speed.order).round()))
+                    .max_by(|a, b| a.1.total_cmp(&b.1))?;
+                (worst.1 > h as f64).then(|| {
+                    format!(
+                        "gear stage `{}` meshes at harmonic {} of the common fundamental (order {:.6}), above the {h} harmonics kept on it",
+                        worst.0.name, worst.1, speed.order
+                    )
+                })
+            }
+        },
+    }
+}
+
+/// The bases before the model is built: names and ratios, and which element follows which.
+#[derive(Debug, Clone)]
+pub(super) struct Layout {
+    names: Vec<String>,
+    ratios: Vec<f64>,
+    /// `(element name, base)` of every element not on base 0.
+    bindings: Vec<(String, usize)>,
+    why: String,
+}
+
+impl Layout {
+    /// Base 0 is `engine` (with an engine table) or `shaft` at the order `f0` of the scene's
+    /// fundamental without the meshes; each varying mesh gets its own base at its mesh order
+    /// (meshes of equal order share one). Takes each element's `base` field out of its table.
+    pub(super) fn new(
+        elements: &mut [Map<String, Value>],
+        meshes: &[Mesh],
+        f0: f64,
+        engine: bool,
+        why: String,
+    ) -> Result<Self, FieldError> {
+        let first = if engine { "engine" } else { "shaft" };
+        let mut layout = Layout {
+            names: vec![first.to_string()],
+            ratios: vec![f0],
+            bindings: Vec::new(),
+            why,
+        };
+        for m in meshes {
+            let same = layout
+                .ratios
+                .iter()
+                .position(|r| (r - m.order).abs() <= 1e-12 * m.order);
+            let b = match same {
+                Some(b) => b,
+                None if layout.names.contains(&m.name) => {
+                    return Err((
+                        format!("elements[{}].name", m.index),
+                        format!("`{}` is also the name of the torus base of the engine or shaft: rename the stage", m.name),
+                    ))
+                }
+                None => {
+                    layout.names.push(m.name.clone());
+                    layout.ratios.push(m.order);
+                    layout.names.len() - 1
+                }
+            };
+            layout.bindings.push((m.name.clone(), b));
+        }
+        if layout.names.len() > Bases::MAX {
+            return Err((
+                "harmonics.bases".into(),
+                format!(
+                    "the torus needs {} bases ({}), at most {} are supported: give the meshes of equal order the same teeth × shaft_order, or use `bases = \"one\"`",
+                    layout.names.len(),
+                    layout.names.join(", "),
+                    Bases::MAX
+                ),
+            ));
+        }
+        for (i, e) in elements.iter_mut().enumerate() {
+            let Some(v) = e.remove("base") else { continue };
+            let at = format!("elements[{i}].base");
+            if e.get("type").and_then(Value::as_str) == Some("gear_stage") {
+                return Err((
+                    at,
+                    "a gear stage follows its own mesh; `base` is for the other elements".into(),
+                ));
+            }
+            let name = v
+                .as_str()
+                .ok_or_else(|| (at.clone(), format!("must be the name of a base, got {v}")))?;
+            let b = layout.names.iter().position(|n| n == name).ok_or_else(|| {
+                (
+                    at.clone(),
+                    format!(
+                        "no base `{name}` (the bases are: {})",
+                        layout.names.join(", ")
+                    ),
+                )
+            })?;
+            let element = e
+                .get("name")
+                .and_then(Value::as_str)
+                .map_or_else(|| format!("element {i}"), str::to_string);
+            layout.bindings.push((element, b));
+        }
+        Ok(layout)
+    }
+
+    /// The order a gear stage counts its mesh against: its base's ratio, or `None` for an
+    /// element on base 0.
+    pub(super) fn stage_order(&self, element: &str) -> Option<f64> {
+        self.bindings
+            .iter()
+            .find(|(n, _)| n == element)
+            .map(|&(_, b)| self.ratios[b])
+    }
+
+    /// The torus of the built `model`: caps, grid and truncation from the `harmonics` table;
+    /// `per_speed` is rad/s per unit of the scene's speed.
+    pub(super) fn finish(
+        self,
+        harmonics: &super::harmonics::Harmonics,
+        model: &Model,
+        per_speed: f64,
+    ) -> Result<TorusPlan, FieldError> {
+        let names: Vec<(&str, f64)> = self
+            .names
+            .iter()
+            .map(String::as_str)
+            .zip(self.ratios.iter().copied())
+            .collect();
+        let bases =
+            Bases::new(&names).map_err(|e| ("harmonics.bases".to_string(), e.to_string()))?;
+        let known = |table: &std::collections::BTreeMap<String, usize>, field: &str| match table
+            .keys()
+            .find(|k| !self.names.contains(k))
+        {
+            Some(k) => Err((
+                format!("harmonics.{field}.{k}"),
+                format!("no base `{k}` (the bases are: {})", self.names.join(", ")),
+            )),
+            None => Ok(()),
+        };
+        known(&harmonics.caps, "caps")?;
+        known(&harmonics.grid, "grid")?;
+        let first = model.max_load_order().max(4);
+        let caps: Vec<usize> = self
+            .names
+            .iter()
+            .enumerate()
+            .map(|(b, n)| {
+                harmonics
+                    .caps
+                    .get(n)
+                    .copied()
+                    .unwrap_or(if b == 0 { first } else { 4 })
+            })
+            .collect();
+        let mut samples = Vec::with_capacity(caps.len());
+        for (n, &c) in self.names.iter().zip(&caps) {
+            let least = 2 * c + 1;
+            let s = harmonics
+                .grid
+                .get(n)
+                .copied()
+                .unwrap_or((2 * c + 3).next_power_of_two());
+            if s < least {
+                return Err((
+                    format!("harmonics.grid.{n}"),
+                    format!("must be at least 2 × cap + 1 = {least} (the cap of base `{n}` is {c}), got {s}"),
+                ));
+            }
+            samples.push(s);
+        }
+        let truncation = harmonics
+            .total
+            .map_or(Truncation::Box, |total| Truncation::Diamond { total });
+        let plan = TorusPlan {
+            bases,
+            bindings: self.bindings,
+            caps,
+            samples,
+            truncation,
+            rad_s_per_speed: per_speed,
+            why: self.why,
+            auto: harmonics.torus_auto()?,
+            tolerance: crate::torus::NewtonKrylov::default().tolerance,
+        };
+        plan.index_set()
+            .map_err(|e| ("harmonics.caps".to_string(), e.to_string()))?;
+        plan.grid_size()
+            .map_err(|e| ("harmonics.grid".to_string(), e))?;
+        Ok(plan)
+    }
+}
+
+/// A scene on several base frequencies: the bases, which element follows which, the index set
+/// and the grid. Loads and elements not named in `bindings` follow base 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TorusPlan {
+    /// The bases; ratios are orders of the scene's speed (the reference shaft).
+    pub bases: Bases,
+    /// `(element, base)` of the elements on another base than the first.
+    pub bindings: Vec<(String, usize)>,
+    /// The cap of each base.
+    pub caps: Vec<usize>,
+    /// Grid points per base.
+    pub samples: Vec<usize>,
+    /// Box or diamond.
+    pub truncation: Truncation,
+    /// Ω (rad/s) per unit of the scene's speed: the bases turn at `Ω r_b`.
+    pub rad_s_per_speed: f64,
+    /// Why the scene is on the torus.
+    pub why: String,
+    /// Automatic caps (`harmonics.auto = true`): the caps above are the first level.
+    pub auto: Option<crate::torus::AutoCaps>,
+    /// Newton–Krylov's tolerance of the relative residual (`--tolerance`).
+    pub tolerance: f64,
+}
+
+impl TorusPlan {
+    /// The index set of the caps.
+    pub fn index_set(&self) -> crate::Result<IndexSet> {
+        IndexSet::new(&self.bases, &self.caps, self.truncation)
+    }
+
+    /// `model` (the scene's) with its elements on their bases.
+    pub fn bind<'m>(&self, model: &'m Model) -> crate::Result<TorusModel<'m>> {
+        let names = self.bases.names();
+        self.bindings
+            .iter()
+            .try_fold(TorusModel::new(model, self.bases.clone()), |tm, (e, b)| {
+                tm.bind_element(e, &names[*b])
+            })
+    }
+
+    fn grid_size(&self) -> Result<(), String> {
+        let points: f64 = self.samples.iter().map(|&s| s as f64).product();
+        if points > crate::torus::MAX_GRID as f64 {
+            return Err(format!(
+                "{points} grid points, at most {}: lower the caps or the grid",
+                crate::torus::MAX_GRID
+            ));
+        }
+        Ok(())
+    }
+}
