@@ -55,6 +55,7 @@ mod sweep_record;
 mod sweep_settings;
 mod torus_lines;
 mod torus_solve;
+mod torus_sweep;
 
 pub use branch_outputs::{contact_loss, point_outputs, ContactLoss};
 pub use compare::{compare, CompareAnalysis, CompareAuto, CompareSettings, MethodComparison};
@@ -74,3 +75,7 @@ pub use sweep_record::SCHEMA_VERSION;
 pub use sweep_settings::{SweepSettings, SweepStart};
 pub use torus_lines::{line_label, LineRecord, Spectrum};
 pub use torus_solve::{torus_solve, BaseRecord, TorusSolveAnalysis, TorusSolveSettings, TOP_LINES};
+pub use torus_sweep::{
+    torus_sweep, OrderCut, TorusPointRecord, TorusSweepAnalysis, TorusSweepSettings,
+    CUTS_PER_ELEMENT,
+};

@@ -60,9 +60,16 @@ pub fn check_sweep_start(scene: &Scene, omega: f64, formulation: crate::Formulat
 /// balance builds at the scene's speed, with automatic harmonics at their first level (H
 /// raised to the load and mesh orders).
 /// Without an operating point (no `fundamental`, `harmonics`), only the model is checked.
+/// A scene on several base frequencies builds its torus balance at its speed.
 pub fn check(scene: &Scene) -> Result<()> {
     if !scene.operating_point {
         return Ok(());
+    }
+    if let Some(plan) = &scene.torus {
+        let omega = plan.speed * plan.rad_s_per_speed;
+        let tm = plan.bind(&scene.model)?;
+        return crate::torus::TorusBalance::new(tm, plan.index_set()?, &plan.samples, omega)
+            .map(|_| ());
     }
     harmonic_balance(scene, scene.basis, crate::Formulation::Auto).map(|_| ())
 }

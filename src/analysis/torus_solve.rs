@@ -2,12 +2,13 @@
 //! (with automatic caps where the scene asks), each base's truncation estimate, the spectra
 //! of every element coordinate and DOF as labelled lines, and the stability statement.
 
-use super::torus_lines::{dof_spectra, element_spectra, Spectrum};
+use super::torus_lines::{coordinate_lines, dof_spectra, element_spectra, spectrum, Spectrum};
 use crate::error::{Error, Result};
 use crate::scene::{Scene, TorusPlan};
 use crate::torus::{
     AutoCapsOutcome, CapsLevel, IndexSet, NewtonKrylov, TorusBalance, TorusSolution, TorusStability,
 };
+use num_complex::Complex64;
 
 /// Lines kept per spectrum.
 pub const TOP_LINES: usize = 12;
@@ -60,12 +61,22 @@ pub struct TorusSolveAnalysis {
     pub caps_stopped: Option<String>,
     /// Every element coordinate's spectrum (a gear stage's: its transmission error, m).
     pub elements: Vec<Spectrum>,
+    /// Every element's force spectrum (a gear stage's: its mesh force, N).
+    pub forces: Vec<Spectrum>,
     /// Every DOF's spectrum.
     pub dofs: Vec<Spectrum>,
     /// The stability statement.
     pub stability: TorusStability,
     /// The solution: every DOF's lines.
     pub solution: TorusSolution,
+    /// Every element coordinate's lines (name, `U_k` on the solution's lines; not in the
+    /// JSON, which has the strongest in `elements`).
+    #[serde(skip)]
+    pub element_lines: Vec<(String, Vec<Complex64>)>,
+    /// Every element's force lines (name, `F_k`; not in the JSON, which has the strongest in
+    /// `forces`).
+    #[serde(skip)]
+    pub force_lines: Vec<(String, Vec<Complex64>)>,
 }
 
 impl TorusSolveAnalysis {
@@ -105,9 +116,7 @@ pub(super) fn plan_of<'s>(scene: &'s Scene, analysis: &str) -> Result<&'s TorusP
 /// ```
 pub fn torus_solve(scene: &Scene, settings: &TorusSolveSettings) -> Result<TorusSolveAnalysis> {
     let plan = plan_of(scene, "solve")?;
-    let speed = settings
-        .speed
-        .unwrap_or(scene.basis.omega() / scene.omega_per_speed);
+    let speed = settings.speed.unwrap_or(plan.speed);
     let omega = speed * plan.rad_s_per_speed;
     crate::harmonic::HarmonicBasis::new(omega, 0).map_err(|_| Error::InvalidOptions {
         option: "speed".into(),
@@ -135,12 +144,17 @@ pub fn torus_solve(scene: &Scene, settings: &TorusSolveSettings) -> Result<Torus
                 solution: solver.solve(&hb, None)?,
                 caps: plan.caps.clone(),
                 samples: plan.samples.clone(),
+                truncation: plan.truncation,
                 levels: Vec::new(),
                 stopped: None,
             }
         }
     };
-    Ok(analysis_of(scene, plan, speed, outcome))
+    // The elements' forces on the last level's lines.
+    let set = IndexSet::new(&plan.bases, &outcome.caps, outcome.truncation)?;
+    let hb = TorusBalance::new(plan.bind(&scene.model)?, set, &outcome.samples, omega)?;
+    let forces = hb.element_force_lines(&outcome.solution)?;
+    Ok(analysis_of(scene, plan, speed, outcome, forces))
 }
 
 /// The analysis record of a solved outcome.
@@ -149,8 +163,21 @@ fn analysis_of(
     plan: &TorusPlan,
     speed: f64,
     outcome: AutoCapsOutcome,
+    forces: Vec<Vec<Complex64>>,
 ) -> TorusSolveAnalysis {
     let sol = outcome.solution;
+    let names = scene.model.elements().iter().map(|e| e.name());
+    let force_spectra = names
+        .zip(&forces)
+        .map(|(name, f)| spectrum(&sol, name, f, TOP_LINES))
+        .collect();
+    let force_lines = scene
+        .model
+        .elements()
+        .iter()
+        .map(|e| e.name().to_string())
+        .zip(forces)
+        .collect();
     let bases = (0..plan.bases.len())
         .map(|b| BaseRecord {
             name: plan.bases.names()[b].clone(),
@@ -172,6 +199,14 @@ fn analysis_of(
         levels: outcome.levels,
         caps_stopped: outcome.stopped,
         elements: element_spectra(&scene.model, &sol, TOP_LINES),
+        forces: force_spectra,
+        force_lines,
+        element_lines: scene
+            .model
+            .elements()
+            .iter()
+            .map(|e| (e.name().to_string(), coordinate_lines(&sol, e.weights())))
+            .collect(),
         dofs: dof_spectra(&sol, TOP_LINES),
         stability: TorusStability::quasi_periodic(),
         solution: sol,

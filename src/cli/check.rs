@@ -15,6 +15,28 @@ pub(crate) fn check(path: &Path) -> Result<u8, Failure> {
             scene.model.n_dofs(),
             scene.model.elements().len(),
         );
+    } else if let Some(plan) = &scene.torus {
+        let bases: Vec<String> = (0..plan.bases.len())
+            .map(|b| {
+                format!(
+                    "{} (order {}, cap {}, grid {})",
+                    plan.bases.names()[b],
+                    super::speed_text(plan.bases.ratios()[b]),
+                    plan.caps[b],
+                    plan.samples[b]
+                )
+            })
+            .collect();
+        say!(
+            "{}: ok ({} DOF(s), {} element(s), on several base frequencies: {}; {} lines, {:?}; {})",
+            scene.file,
+            scene.model.n_dofs(),
+            scene.model.elements().len(),
+            bases.join(", "),
+            plan.index_set().map_or(0, |s| s.len()),
+            plan.truncation,
+            plan.why
+        );
     } else {
         say!(
         "{}: ok ({} DOF(s), {} element(s), Ω = {:.6} rad/s (order {} of the {} speed), H = {}, \

@@ -40,6 +40,8 @@ pub(crate) mod sweep_command;
 mod sweep_files;
 pub(crate) mod sweep_summary;
 mod sweep_text;
+pub(crate) mod torus_solve;
+pub(crate) mod torus_sweep;
 
 /// An error with its exit code.
 pub(crate) struct Failure {

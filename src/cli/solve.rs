@@ -23,6 +23,13 @@ pub(crate) struct SolveOptions<'a> {
 pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Result<u8, Failure> {
     let as_json = opts.json;
     let scene = load(path, args)?;
+    if scene.torus.is_some() {
+        super::torus_solve::refuse_flags(&[
+            ("--start", opts.start.is_some()),
+            ("--no-fallback", !opts.fallback),
+        ])?;
+        return super::torus_solve::solve(&scene, as_json, opts.out);
+    }
     if let Some(dir) = opts.out {
         super::prepare_out(dir, &super::solve_files())?;
     }

@@ -56,6 +56,27 @@ impl SweepOptions<'_> {
 pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Result<u8, Failure> {
     let as_json = opts.json;
     let scene = load(path, args)?;
+    if scene.torus.is_some() {
+        super::torus_solve::refuse_flags(&[
+            ("--start", opts.start.is_some()),
+            ("--all-branches", opts.all_branches),
+            ("--max-points", opts.max_points.is_some()),
+            ("--dofs", opts.dofs.is_some()),
+            (
+                "--stability-orbit",
+                opts.orbit != hbal::stability::Orbit::Exact,
+            ),
+        ])?;
+        let torus = super::torus_sweep::TorusSweepOptions {
+            from: opts.from,
+            to: opts.to,
+            points: opts.points,
+            json: as_json,
+            out: opts.out,
+            output: opts.output,
+        };
+        return super::torus_sweep::sweep(&scene, torus);
+    }
     let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
     let start = start.zip(opts.start).map(|(s, file)| SweepStart {
         harmonics: s.harmonics,

@@ -26,6 +26,8 @@ pub(super) struct Fundamental {
 pub(super) struct Speed {
     /// `rpm`, `hz` or `rad_s`.
     pub(super) unit: &'static str,
+    /// The speed as the scene gives it, in `unit`.
+    pub(super) speed: f64,
     /// rad/s per unit of speed of the reference shaft.
     pub(super) per_unit: f64,
     /// The order f of the fundamental: Ω = f Ω_ref.
@@ -101,6 +103,7 @@ impl Fundamental {
         }
         Ok(Speed {
             unit,
+            speed,
             per_unit,
             order,
             omega,

@@ -355,7 +355,7 @@ impl SceneFile {
             .harmonics
             .unwrap_or_else(|| harmonics::Harmonics::placeholder(model.max_order().max(1)));
         let torus = layout
-            .map(|l| l.finish(&harmonics, &model, speed.per_unit))
+            .map(|l| l.finish(&harmonics, &model, &speed))
             .transpose()
             .map_err(|(path, message)| err(&path, message))?;
         let (basis, auto) = match &torus {
@@ -392,7 +392,7 @@ impl Scene {
         if let Some(plan) = &self.torus {
             return Err(crate::Error::InvalidElement {
                 context: format!("`{analysis}`"),
-                reason: format!("runs on one fundamental, and this scene is solved on several base frequencies ({}): `hbal solve` and `hbal sweep` solve it there (crate::analysis::torus_solve, torus_sweep); `harmonics.bases = \"one\"` puts it on one fundamental", plan.why),
+                reason: format!("runs on one fundamental, and this scene is solved on several base frequencies ({}): `hbal solve` and `hbal sweep` solve it there (in the library: analysis::torus_solve, torus_sweep); `harmonics.bases = \"one\"` puts it on one fundamental", plan.why),
             });
         }
         if self.operating_point {

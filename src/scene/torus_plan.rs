@@ -189,13 +189,13 @@ impl Layout {
             .map(|&(_, b)| self.ratios[b])
     }
 
-    /// The torus of the built `model`: caps, grid and truncation from the `harmonics` table;
-    /// `per_speed` is rad/s per unit of the scene's speed.
+    /// The torus of the built `model` at the scene's `speed`: caps, grid and truncation from
+    /// the `harmonics` table.
     pub(super) fn finish(
         self,
         harmonics: &super::harmonics::Harmonics,
         model: &Model,
-        per_speed: f64,
+        speed: &Speed,
     ) -> Result<TorusPlan, FieldError> {
         let names: Vec<(&str, f64)> = self
             .names
@@ -255,7 +255,8 @@ impl Layout {
             caps,
             samples,
             truncation,
-            rad_s_per_speed: per_speed,
+            rad_s_per_speed: speed.per_unit,
+            speed: speed.speed,
             why: self.why,
             auto: harmonics.torus_auto()?,
             tolerance: crate::torus::NewtonKrylov::default().tolerance,
@@ -284,6 +285,8 @@ pub struct TorusPlan {
     pub truncation: Truncation,
     /// Ω (rad/s) per unit of the scene's speed: the bases turn at `Ω r_b`.
     pub rad_s_per_speed: f64,
+    /// The scene's speed, in its unit.
+    pub speed: f64,
     /// Why the scene is on the torus.
     pub why: String,
     /// Automatic caps (`harmonics.auto = true`): the caps above are the first level.

@@ -60,6 +60,8 @@ pub struct AutoCapsOutcome {
     pub caps: Vec<usize>,
     /// Grid points per base of the last level.
     pub samples: Vec<usize>,
+    /// The last level's truncation (a diamond's total grows with the caps).
+    pub truncation: Truncation,
     /// Every level in order.
     pub levels: Vec<CapsLevel>,
     /// `None` if every estimate is below the tolerance, else why it stopped.
@@ -102,6 +104,7 @@ impl AutoCaps {
                             solution,
                             caps,
                             samples,
+                            truncation,
                             levels,
                             stopped,
                         });
@@ -134,6 +137,7 @@ impl AutoCaps {
                     solution,
                     caps,
                     samples,
+                    truncation: set.truncation(),
                     levels,
                     stopped,
                 });

@@ -24,11 +24,11 @@ use std::f64::consts::TAU;
 pub struct TorusBalance<'m> {
     tm: TorusModel<'m>,
     pub(super) set: IndexSet,
-    fft: TorusFft,
+    pub(super) fft: TorusFft,
     omega: f64,
     coordinates: Vec<Vec<(usize, f64)>>,
     names: Vec<String>,
-    active: Vec<TorusElement>,
+    pub(super) active: Vec<TorusElement>,
     /// Per base, its `N_b` sample angles `2π j / N_b` (one grid line along it).
     line_thetas: Vec<Vec<f64>>,
     pub(super) dense: crate::model::DenseMatrices,
@@ -44,12 +44,12 @@ pub struct TorusBalance<'m> {
 #[derive(Debug, Clone)]
 pub struct TorusWorkspace {
     pub(super) fft: TorusScratch,
-    u: Vec<Vec<f64>>,
-    du: Vec<Vec<f64>>,
+    pub(super) u: Vec<Vec<f64>>,
+    pub(super) du: Vec<Vec<f64>>,
     pub(super) force: Vec<Vec<f64>>,
     ue: Vec<f64>,
     due: Vec<f64>,
-    fe: Vec<f64>,
+    pub(super) fe: Vec<f64>,
     ge: Vec<f64>,
     gde: Vec<f64>,
     /// `Σ_e s² (∂f/∂u - k0)`, `Σ_e s² (∂f/∂u̇ - d0)` per coordinate at the last evaluation
@@ -319,18 +319,8 @@ impl<'m> TorusBalance<'m> {
         let (n, stride) = self.axis(act.base);
         let line = &self.line_thetas[act.base];
         let theta = |p: usize| line[(p / stride) % n];
-        for (x, &v) in ws.ue.iter_mut().zip(&ws.u[c]) {
-            *x = s * v;
-        }
-        for (x, &v) in ws.due.iter_mut().zip(&ws.du[c]) {
-            *x = s * v;
-        }
-        self.law_batches(act.base, law, false, ws);
         let delta = 1e-7 * TAU / self.fft.dims()[act.base] as f64;
-        for &p in &act.jumps {
-            let (t, x, v) = (theta(p), ws.ue[p], ws.due[p]);
-            ws.fe[p] = 0.5 * (law.force(t - delta, x, v) + law.force(t + delta, x, v));
-        }
+        self.law_samples(act, ws);
         for (((f, &x), &v), acc) in ws.fe.iter().zip(&ws.ue).zip(&ws.due).zip(&mut ws.force[c]) {
             let rest = f - lin.offset - lin.stiffness * x - lin.damping * v;
             if !rest.is_finite() {
@@ -364,6 +354,31 @@ impl<'m> TorusBalance<'m> {
             }
         }
         Ok(())
+    }
+
+    /// The element's coordinate `u_e = s u_c` and its rate into `ws.ue`, `ws.due` (from
+    /// `ws.u`, `ws.du`) and its law's force at every grid point into `ws.fe`, the samples on
+    /// the law's time jumps averaged across the jump.
+    pub(super) fn law_samples(&self, act: &TorusElement, ws: &mut TorusWorkspace) {
+        let law = act
+            .band_limited
+            .as_deref()
+            .unwrap_or(self.tm.model().elements()[act.index].law());
+        let (c, s) = (act.coordinate, act.factor);
+        for (x, &v) in ws.ue.iter_mut().zip(&ws.u[c]) {
+            *x = s * v;
+        }
+        for (x, &v) in ws.due.iter_mut().zip(&ws.du[c]) {
+            *x = s * v;
+        }
+        self.law_batches(act.base, law, false, ws);
+        let (n, stride) = self.axis(act.base);
+        let line = &self.line_thetas[act.base];
+        let delta = 1e-7 * TAU / self.fft.dims()[act.base] as f64;
+        for &p in &act.jumps {
+            let (t, x, v) = (line[(p / stride) % n], ws.ue[p], ws.due[p]);
+            ws.fe[p] = 0.5 * (law.force(t - delta, x, v) + law.force(t + delta, x, v));
+        }
     }
 
     /// The law's force at every grid point into `ws.fe` (or its derivatives into `ws.ge`,
@@ -412,7 +427,7 @@ impl<'m> TorusBalance<'m> {
     }
 
     /// Samples of coordinate c of `u` (or of its time derivative) into `out`.
-    fn synthesize(
+    pub(super) fn synthesize(
         &self,
         u: &[Complex64],
         c: usize,

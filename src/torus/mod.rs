@@ -44,6 +44,7 @@ mod anderson;
 mod auto_caps;
 mod balance;
 mod bases;
+mod element_force;
 mod elements;
 mod estimate;
 mod fixed_point;

@@ -19,6 +19,12 @@ fn every_example_scene_solves_and_checks() {
             "check {p}: {}",
             String::from_utf8_lossy(&out.stderr)
         );
+        if std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("bases = \"torus\"")
+        {
+            continue; // on several base frequencies: tests/integration/torus_cli.rs
+        }
         let out = hbal(&["solve", p, "--json"]);
         assert_eq!(
             out.status.code(),

@@ -81,5 +81,6 @@ mod stability_worker;
 mod tail_correction;
 mod threads;
 mod torus;
+mod torus_cli;
 mod torus_scene;
 mod two_level;
