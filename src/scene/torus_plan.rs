@@ -5,7 +5,8 @@
 //!
 //! `harmonics.bases = "auto"` (the default) keeps one fundamental wherever it holds the
 //! meshes, as before, and takes the torus where it cannot: the engine and mesh orders have no
-//! common fundamental, or a mesh's first harmonic lies above the harmonics the scene keeps.
+//! common fundamental, or a mesh's first harmonic lies above the harmonics the scene keeps
+//! and above harmonic 64 (a long common period).
 
 use super::fundamental::Speed;
 use crate::model::Model;
@@ -14,6 +15,11 @@ use serde::Deserialize;
 use serde_json::{Map, Value};
 
 type FieldError = (String, String);
+
+/// Mesh harmonics of the common fundamental up to which its period counts as short: there
+/// one fundamental stays, and too few harmonics are an error to fix, not a reason for the
+/// torus.
+const SHORT_PERIOD: f64 = 64.0;
 
 /// `harmonics.bases`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
@@ -79,7 +85,7 @@ pub(super) fn choose(
                     .iter()
                     .map(|m| (m, (m.order / speed.order).round()))
                     .max_by(|a, b| a.1.total_cmp(&b.1))?;
-                (worst.1 > h as f64).then(|| {
+                (worst.1 > (h as f64).max(SHORT_PERIOD)).then(|| {
                     format!(
                         "gear stage `{}` meshes at harmonic {} of the common fundamental (order {:.6}), above the {h} harmonics kept on it",
                         worst.0.name, worst.1, speed.order

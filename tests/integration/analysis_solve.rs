@@ -27,6 +27,9 @@ fn the_cli_json_is_the_serialised_library_result_for_every_example_scene() {
     assert!(paths.len() >= 20, "{} scenes", paths.len());
     for path in paths {
         let scene = Scene::load(&path).unwrap();
+        if scene.torus.is_some() {
+            continue; // on several base frequencies: tests/integration/torus_cli.rs
+        }
         let analysis = solve(&scene, &SolveSettings::default()).unwrap();
         // Through text, as the CLI's: serde_json's parser may round a float's last digit.
         let mut library: Value =

@@ -50,6 +50,8 @@ fn the_cli_json_is_the_serialised_library_sweep_for_every_example_scene() {
     let paths: Vec<_> = scenes()
         .into_iter()
         .filter(|p| !p.ends_with("car_drivetrain_two_stage.toml"))
+        // On several base frequencies: tests/integration/torus_cli.rs.
+        .filter(|p| Scene::load(p).unwrap().torus.is_none())
         .collect();
     assert!(paths.len() >= 19, "{} scenes", paths.len());
     for path in paths {

@@ -181,6 +181,9 @@ fn every_example_scene_sweeps_around_its_speed() {
         }
         let p = path.to_str().unwrap();
         let scene = hbal::scene::Scene::load(&path).unwrap();
+        if scene.torus.is_some() {
+            continue; // on several base frequencies: tests/integration/torus_cli.rs
+        }
         let speed = scene.basis.omega() / scene.omega_per_speed;
         for to in [1.05 * speed, 0.95 * speed] {
             let to_arg = format!("{to}");
