@@ -10,6 +10,7 @@ use nalgebra::DMatrix;
 enum PendingElement {
     Law(String, Vec<(String, f64)>, Box<dyn ForceLaw>),
     Stage(String, GearStage),
+    Planetary(String, super::PlanetarySet),
 }
 
 /// A matrix as given: dense, or assembled from triplets.
@@ -216,6 +217,14 @@ impl ModelBuilder {
         self
     }
 
+    /// Adds a planetary set: its `2N` meshes as elements `name sun 1`, ..., `name ring N`
+    /// ([`PlanetarySet`](super::PlanetarySet) for the coordinates and phasing).
+    pub fn planetary(mut self, name: &str, set: super::PlanetarySet) -> Self {
+        self.elements
+            .push(PendingElement::Planetary(name.to_string(), set));
+        self
+    }
+
     /// Validates and builds the model.
     pub fn build(self) -> Result<Model> {
         let n = self.dofs.len();
@@ -318,9 +327,15 @@ impl ModelBuilder {
         }
 
         let mut elements = Vec::with_capacity(self.elements.len());
-        for pending in self.elements {
+        for pending in expand_planetaries(self.elements)? {
             let (name, weights, law, stage) = match pending {
                 PendingElement::Law(name, weights, law) => (name, weights, law, None),
+                PendingElement::Planetary(name, _) => {
+                    return Err(Error::InvalidElement {
+                        context: format!("planetary set `{name}`"),
+                        reason: "not expanded into its meshes (an internal error)".into(),
+                    })
+                }
                 PendingElement::Stage(name, stage) => {
                     stage.validate(&format!("gear stage `{name}`"))?;
                     let (weights, law) = stage.element();
@@ -423,4 +438,26 @@ fn check_spd(m: &SparseMatrix) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// Every planetary set as its meshes (validated first).
+fn expand_planetaries(pending: Vec<PendingElement>) -> Result<Vec<PendingElement>> {
+    let mut out = Vec::with_capacity(pending.len());
+    for p in pending {
+        match p {
+            PendingElement::Planetary(name, set) => {
+                set.validate(&format!("planetary set `{name}`"))?;
+                for (suffix, weights, law) in set.meshes() {
+                    let weights = weights.iter().map(|(d, w)| (d.to_string(), *w)).collect();
+                    out.push(PendingElement::Law(
+                        format!("{name} {suffix}"),
+                        weights,
+                        law,
+                    ));
+                }
+            }
+            other => out.push(other),
+        }
+    }
+    Ok(out)
 }

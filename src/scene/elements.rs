@@ -47,6 +47,19 @@ pub(super) fn add(
             builder = builder.gear_stage(&name, stage);
             continue;
         }
+        if e.get("type").and_then(Value::as_str) == Some("planetary") {
+            e.remove("type");
+            let order = stage_order(&name).unwrap_or(fundamental_order);
+            let set = super::planetary::read(e, &name, dofs, order, |f| {
+                if f.is_empty() {
+                    format!("elements[{i}]")
+                } else {
+                    at(f)
+                }
+            })?;
+            builder = builder.planetary(&name, set);
+            continue;
+        }
         let connects: BTreeMap<String, f64> = match e.remove("connects") {
             Some(v) => serde_path_to_error::deserialize(v).map_err(|x| {
                 fail(

@@ -112,27 +112,33 @@ impl Fundamental {
     }
 }
 
-/// `teeth × shaft_order` of a `gear_stage` table whose stiffness varies with the mesh cycle,
-/// read leniently (the stage's own check reports bad values); `None` for a constant
-/// stiffness, which has no mesh order.
+/// The mesh order of the speed of a `gear_stage` (`teeth × shaft_order`) or `planetary`
+/// (`z_s |sun_order − carrier_order|`) table whose stiffness varies, read leniently (the
+/// element's own check reports bad values); `None` for a constant stiffness, which has no
+/// mesh order, and for other elements.
 pub(super) fn stage_mesh_order(e: &Map<String, Value>) -> Option<f64> {
-    if e.get("type").and_then(Value::as_str) != Some("gear_stage") {
-        return None;
-    }
-    let shape = e
-        .get("stiffness")
-        .and_then(|s| s.get("shape"))
-        .and_then(Value::as_str);
-    let flat = e
-        .get("stiffness")
-        .and_then(|s| s.get("amplitude"))
-        .and_then(Value::as_f64)
-        == Some(0.0);
-    if shape == Some("constant") || (shape == Some("cosine") && flat) {
-        return None;
-    }
-    let teeth = e.get("teeth")?.as_f64()?;
-    let shaft = e.get("shaft_order").map_or(Some(1.0), Value::as_f64)?;
-    let z = teeth * shaft;
+    let varies = |field: &str| {
+        let s = e.get(field);
+        let shape = s.and_then(|s| s.get("shape")).and_then(Value::as_str);
+        let flat = s.and_then(|s| s.get("amplitude")).and_then(Value::as_f64) == Some(0.0);
+        !(shape == Some("constant") || (shape == Some("cosine") && flat))
+    };
+    let z = match e.get("type").and_then(Value::as_str)? {
+        "gear_stage" if varies("stiffness") => {
+            let teeth = e.get("teeth")?.as_f64()?;
+            teeth * e.get("shaft_order").map_or(Some(1.0), Value::as_f64)?
+        }
+        "planetary" if varies("sun_stiffness") || varies("ring_stiffness") => {
+            let teeth = e.get("teeth")?.as_array()?;
+            let (zs, zr) = (teeth.first()?.as_f64()?, teeth.get(1)?.as_f64()?);
+            let sun = e.get("sun_order").map_or(Some(1.0), Value::as_f64)?;
+            let carrier = match e.get("carrier_order") {
+                Some(c) => c.as_f64()?,
+                None => sun * zs / (zs + zr),
+            };
+            zs * (sun - carrier).abs()
+        }
+        _ => return None,
+    };
     (z.is_finite() && z > 0.0).then_some(z)
 }

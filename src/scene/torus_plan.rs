@@ -5,8 +5,9 @@
 //!
 //! `harmonics.bases = "auto"` (the default) keeps one fundamental wherever it holds the
 //! meshes, as before, and takes the torus where it cannot: the engine and mesh orders have no
-//! common fundamental, or a mesh's first harmonic lies above the harmonics the scene keeps
-//! and above harmonic 64 (a long common period).
+//! common fundamental, a mesh's order is not a harmonic of the scene's fundamental, or a
+//! mesh's first harmonic lies above the harmonics the scene keeps and above harmonic 64 (a
+//! long common period).
 
 use super::fundamental::Speed;
 use crate::model::Model;
@@ -34,12 +35,14 @@ pub(super) enum BasesChoice {
     Torus,
 }
 
-/// A gear stage with a varying stiffness: where it is, its name and mesh order `z s`.
+/// A gear stage or planetary set with a varying stiffness: where it is, its name, its mesh
+/// order of the speed and the model elements it becomes.
 #[derive(Debug, Clone)]
 pub(super) struct Mesh {
     index: usize,
     name: String,
     order: f64,
+    elements: Vec<String>,
 }
 
 /// The varying gear stages of the raw element tables.
@@ -53,10 +56,21 @@ pub(super) fn meshes(elements: &[Map<String, Value>]) -> Vec<Mesh> {
                 .get("name")
                 .and_then(Value::as_str)
                 .map_or_else(|| format!("element {i}"), str::to_string);
+            let planets = e.get("planets").and_then(Value::as_array).map(Vec::len);
+            let elements = match planets {
+                Some(n) if e.get("type").and_then(Value::as_str) == Some("planetary") => {
+                    let part = |kind: &str| -> Vec<String> {
+                        (1..=n).map(|p| format!("{name} {kind} {p}")).collect()
+                    };
+                    [part("sun"), part("ring")].concat()
+                }
+                _ => vec![name.clone()],
+            };
             Some(Mesh {
                 index: i,
                 name,
                 order,
+                elements,
             })
         })
         .collect()
@@ -80,6 +94,16 @@ pub(super) fn choose(
                     .into(),
             ),
             Ok(speed) => {
+                let off = meshes.iter().find(|m| {
+                    let z = m.order / speed.order;
+                    (z - z.round()).abs() > 1e-9 * z.max(1.0)
+                });
+                if let Some(m) = off {
+                    return Some(format!(
+                        "the mesh order {:.6} of `{}` is not a harmonic of the fundamental (order {:.6})",
+                        m.order, m.name, speed.order
+                    ));
+                }
                 let h = harmonics?;
                 let worst = meshes
                     .iter()
@@ -101,8 +125,11 @@ pub(super) fn choose(
 pub(super) struct Layout {
     names: Vec<String>,
     ratios: Vec<f64>,
-    /// `(element name, base)` of every element not on base 0.
+    /// `(element name, base)` of every model element not on base 0.
     bindings: Vec<(String, usize)>,
+    /// `(table name, order)` of every gear stage and planetary set: the order its meshes
+    /// count against.
+    orders: Vec<(String, f64)>,
     why: String,
 }
 
@@ -122,6 +149,7 @@ impl Layout {
             names: vec![first.to_string()],
             ratios: vec![f0],
             bindings: Vec::new(),
+            orders: Vec::new(),
             why,
         };
         for m in meshes {
@@ -143,7 +171,10 @@ impl Layout {
                     layout.names.len() - 1
                 }
             };
-            layout.bindings.push((m.name.clone(), b));
+            layout.orders.push((m.name.clone(), layout.ratios[b]));
+            for e in &m.elements {
+                layout.bindings.push((e.clone(), b));
+            }
         }
         if layout.names.len() > Bases::MAX {
             return Err((
@@ -159,10 +190,13 @@ impl Layout {
         for (i, e) in elements.iter_mut().enumerate() {
             let Some(v) = e.remove("base") else { continue };
             let at = format!("elements[{i}].base");
-            if e.get("type").and_then(Value::as_str) == Some("gear_stage") {
+            if matches!(
+                e.get("type").and_then(Value::as_str),
+                Some("gear_stage" | "planetary")
+            ) {
                 return Err((
                     at,
-                    "a gear stage follows its own mesh; `base` is for the other elements".into(),
+                    "a gear stage or planetary set follows its own mesh; `base` is for the other elements".into(),
                 ));
             }
             let name = v
@@ -189,10 +223,10 @@ impl Layout {
     /// The order a gear stage counts its mesh against: its base's ratio, or `None` for an
     /// element on base 0.
     pub(super) fn stage_order(&self, element: &str) -> Option<f64> {
-        self.bindings
+        self.orders
             .iter()
             .find(|(n, _)| n == element)
-            .map(|&(_, b)| self.ratios[b])
+            .map(|&(_, r)| r)
     }
 
     /// The torus of the built `model` at the scene's `speed`: caps, grid and truncation from

@@ -22,7 +22,7 @@ use std::f64::consts::TAU;
 /// The torus harmonic balance of a [`TorusModel`] on an index set and grid, at speed Ω.
 #[derive(Debug)]
 pub struct TorusBalance<'m> {
-    tm: TorusModel<'m>,
+    pub(super) tm: TorusModel<'m>,
     pub(super) set: IndexSet,
     pub(super) fft: TorusFft,
     omega: f64,
@@ -30,7 +30,7 @@ pub struct TorusBalance<'m> {
     names: Vec<String>,
     pub(super) active: Vec<TorusElement>,
     /// Per base, its `N_b` sample angles `2π j / N_b` (one grid line along it).
-    line_thetas: Vec<Vec<f64>>,
+    pub(super) line_thetas: Vec<Vec<f64>>,
     pub(super) dense: crate::model::DenseMatrices,
     pub(super) augmentation: Option<DMatrix<f64>>,
     /// The rigid-body modes of a free-free model, whose mean loads must balance at every speed.
@@ -47,17 +47,19 @@ pub struct TorusWorkspace {
     pub(super) u: Vec<Vec<f64>>,
     pub(super) du: Vec<Vec<f64>>,
     pub(super) force: Vec<Vec<f64>>,
-    ue: Vec<f64>,
-    due: Vec<f64>,
+    pub(super) ue: Vec<f64>,
+    pub(super) due: Vec<f64>,
     pub(super) fe: Vec<f64>,
-    ge: Vec<f64>,
-    gde: Vec<f64>,
+    pub(super) ge: Vec<f64>,
+    pub(super) gde: Vec<f64>,
     /// `Σ_e s² (∂f/∂u - k0)`, `Σ_e s² (∂f/∂u̇ - d0)` per coordinate at the last evaluation
     /// with derivatives.
     pub(super) gu: Vec<Vec<f64>>,
     pub(super) gdu: Vec<Vec<f64>>,
     /// One grid line along a base: `u`, `u̇` and the law's values there.
-    lines: [Vec<f64>; 4],
+    pub(super) lines: [Vec<f64>; 4],
+    /// One line's m coordinates (the receptance form's `G_j x_j`).
+    line: Vec<Complex64>,
     /// Transforms done.
     pub ffts: usize,
 }
@@ -168,6 +170,7 @@ impl<'m> TorusBalance<'m> {
             lines: std::array::from_fn(|_| {
                 vec![0.0; self.fft.dims().iter().copied().max().unwrap_or(0)]
             }),
+            line: vec![Complex64::default(); m],
             ffts: 0,
         }
     }
@@ -240,8 +243,9 @@ impl<'m> TorusBalance<'m> {
         u
     }
 
-    /// `out ← R(U) = G⁻¹ U + N(U) - L`; with `derivatives`, the samples the Jacobian needs
-    /// are kept in `ws`.
+    /// `out ← R(U) = G⁻¹ U + N(U) - L` (in the receptance form of dependent coordinates
+    /// `R(U) = U + G N(U) − G L`); with `derivatives`, the samples the Jacobian needs are
+    /// kept in `ws`.
     pub fn residual_into(
         &self,
         u: &[Complex64],
@@ -251,6 +255,13 @@ impl<'m> TorusBalance<'m> {
     ) -> Result<()> {
         self.rest_into(u, out, derivatives, ws)?;
         let m = self.coordinates();
+        if self.linear.receptance_form {
+            self.times_receptance_plus(u, out, ws);
+            for (o, l) in out.iter_mut().zip(&self.linear.load) {
+                *o -= l;
+            }
+            return Ok(());
+        }
         for (j, g) in self.linear.stiffness.iter().enumerate() {
             let x = &u[j * m..(j + 1) * m];
             for (a, o) in out[j * m..(j + 1) * m].iter_mut().enumerate() {
@@ -282,150 +293,6 @@ impl<'m> TorusBalance<'m> {
         Ok(())
     }
 
-    /// The rest's samples per coordinate into `ws.force` (and the derivative samples).
-    pub(super) fn force_samples(
-        &self,
-        u: &[Complex64],
-        derivatives: bool,
-        ws: &mut TorusWorkspace,
-    ) -> Result<()> {
-        for c in 0..self.coordinates() {
-            self.synthesize(u, c, false, &mut ws.u[c], &mut ws.fft);
-            self.synthesize(u, c, true, &mut ws.du[c], &mut ws.fft);
-            ws.ffts += 2;
-            ws.force[c].fill(0.0);
-            if derivatives {
-                ws.gu[c].fill(0.0);
-                ws.gdu[c].fill(0.0);
-            }
-        }
-        for act in &self.active {
-            self.element_force(act, derivatives, ws)?;
-        }
-        Ok(())
-    }
-
-    /// One element's rest into its coordinate's force samples (and derivative samples).
-    fn element_force(
-        &self,
-        act: &TorusElement,
-        derivatives: bool,
-        ws: &mut TorusWorkspace,
-    ) -> Result<()> {
-        let e = &self.tm.model().elements()[act.index];
-        let law = act.band_limited.as_deref().unwrap_or(e.law());
-        let (c, s, lin) = (act.coordinate, act.factor, act.linear);
-        // The base's angle at grid point p (for the samples on the law's time jumps).
-        let (n, stride) = self.axis(act.base);
-        let line = &self.line_thetas[act.base];
-        let theta = |p: usize| line[(p / stride) % n];
-        let delta = 1e-7 * TAU / self.fft.dims()[act.base] as f64;
-        self.law_samples(act, ws);
-        for (((f, &x), &v), acc) in ws.fe.iter().zip(&ws.ue).zip(&ws.due).zip(&mut ws.force[c]) {
-            let rest = f - lin.offset - lin.stiffness * x - lin.damping * v;
-            if !rest.is_finite() {
-                return Err(Error::NonFinite {
-                    what: format!(
-                        "the force of element `{}` on the torus grid (u = {x:e}, u̇ = {v:e})",
-                        e.name()
-                    ),
-                });
-            }
-            *acc += s * rest;
-        }
-        if derivatives {
-            self.law_batches(act.base, law, true, ws);
-            for &p in &act.jumps {
-                let (t, x, v) = (theta(p), ws.ue[p], ws.due[p]);
-                let (a0, b0) = law.derivatives(t - delta, x, v);
-                let (a1, b1) = law.derivatives(t + delta, x, v);
-                (ws.ge[p], ws.gde[p]) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
-            }
-            let s2 = s * s;
-            for p in 0..ws.ge.len() {
-                let (a, b) = (ws.ge[p] - lin.stiffness, ws.gde[p] - lin.damping);
-                if !(a.is_finite() && b.is_finite()) {
-                    return Err(Error::NonFinite {
-                        what: format!("the force derivatives of element `{}`", e.name()),
-                    });
-                }
-                ws.gu[c][p] += s2 * a;
-                ws.gdu[c][p] += s2 * b;
-            }
-        }
-        Ok(())
-    }
-
-    /// The element's coordinate `u_e = s u_c` and its rate into `ws.ue`, `ws.due` (from
-    /// `ws.u`, `ws.du`) and its law's force at every grid point into `ws.fe`, the samples on
-    /// the law's time jumps averaged across the jump.
-    pub(super) fn law_samples(&self, act: &TorusElement, ws: &mut TorusWorkspace) {
-        let law = act
-            .band_limited
-            .as_deref()
-            .unwrap_or(self.tm.model().elements()[act.index].law());
-        let (c, s) = (act.coordinate, act.factor);
-        for (x, &v) in ws.ue.iter_mut().zip(&ws.u[c]) {
-            *x = s * v;
-        }
-        for (x, &v) in ws.due.iter_mut().zip(&ws.du[c]) {
-            *x = s * v;
-        }
-        self.law_batches(act.base, law, false, ws);
-        let (n, stride) = self.axis(act.base);
-        let line = &self.line_thetas[act.base];
-        let delta = 1e-7 * TAU / self.fft.dims()[act.base] as f64;
-        for &p in &act.jumps {
-            let (t, x, v) = (line[(p / stride) % n], ws.ue[p], ws.due[p]);
-            ws.fe[p] = 0.5 * (law.force(t - delta, x, v) + law.force(t + delta, x, v));
-        }
-    }
-
-    /// The law's force at every grid point into `ws.fe` (or its derivatives into `ws.ge`,
-    /// `ws.gde`), from `ws.ue`, `ws.due`, evaluated line by line along the base's own axis: every
-    /// batch a law sees is its base's equidistant angles in order, never the angles repeated
-    /// along the other axes (a law may take a shortcut on equidistant angles, as
-    /// [`MeshProfile::values_into`](crate::force::MeshProfile::values_into) does).
-    #[allow(clippy::needless_range_loop)] // j indexes the line and, through `at`, the grid
-    fn law_batches(
-        &self,
-        base: usize,
-        law: &dyn crate::force::ForceLaw,
-        derivatives: bool,
-        ws: &mut TorusWorkspace,
-    ) {
-        let (n, stride) = self.axis(base);
-        let theta = &self.line_thetas[base];
-        let lines = &mut ws.lines;
-        for o in 0..self.fft.points() / (n * stride) {
-            for i in 0..stride {
-                let at = |j: usize| o * n * stride + j * stride + i;
-                for j in 0..n {
-                    (lines[0][j], lines[1][j]) = (ws.ue[at(j)], ws.due[at(j)]);
-                }
-                let [u, du, f, g, ..] = lines;
-                let (u, du) = (&u[..n], &du[..n]);
-                if derivatives {
-                    law.derivatives_batch(theta, u, du, &mut f[..n], &mut g[..n]);
-                    for j in 0..n {
-                        (ws.ge[at(j)], ws.gde[at(j)]) = (f[j], g[j]);
-                    }
-                } else {
-                    law.force_batch(theta, u, du, &mut f[..n]);
-                    for j in 0..n {
-                        ws.fe[at(j)] = f[j];
-                    }
-                }
-            }
-        }
-    }
-
-    /// The samples `N_b` of base b's axis and its stride in the grid.
-    fn axis(&self, base: usize) -> (usize, usize) {
-        let dims = self.fft.dims();
-        (dims[base], dims[base + 1..].iter().product())
-    }
-
     /// Samples of coordinate c of `u` (or of its time derivative) into `out`.
     pub(super) fn synthesize(
         &self,
@@ -453,7 +320,11 @@ impl<'m> TorusBalance<'m> {
     /// [`residual_into`](Self::residual_into) with derivatives.
     pub fn jacobian_apply(&self, v: &[Complex64], out: &mut [Complex64], ws: &mut TorusWorkspace) {
         let m = self.coordinates();
-        self.linear.apply_stiffness(v, out);
+        if self.linear.receptance_form {
+            out.fill(Complex64::default());
+        } else {
+            self.linear.apply_stiffness(v, out);
+        }
         for c in 0..m {
             let (mut x, mut dx) = (std::mem::take(&mut ws.ue), std::mem::take(&mut ws.due));
             self.synthesize(v, c, false, &mut x, &mut ws.fft);
@@ -466,6 +337,9 @@ impl<'m> TorusBalance<'m> {
                 .analyze(&mut x, &mut ws.fft, |j, val| out[j * m + c] += val);
             ws.ffts += 1;
             (ws.ue, ws.due) = (x, dx);
+        }
+        if self.linear.receptance_form {
+            self.times_receptance_plus(v, out, ws);
         }
     }
 
@@ -481,6 +355,29 @@ impl<'m> TorusBalance<'m> {
                 )
             })
             .collect()
+    }
+
+    /// `out_j ← x_j + G_j out_j` line by line (the receptance form).
+    fn times_receptance_plus(
+        &self,
+        x: &[Complex64],
+        out: &mut [Complex64],
+        ws: &mut TorusWorkspace,
+    ) {
+        let m = self.coordinates();
+        for (j, g) in self.linear.receptance.iter().enumerate() {
+            let o = &mut out[j * m..(j + 1) * m];
+            for a in 0..m {
+                ws.line[a] = x[j * m + a] + (0..m).map(|b| g[(a, b)] * o[b]).sum::<Complex64>();
+            }
+            o.copy_from_slice(&ws.line);
+        }
+    }
+
+    /// Whether the balance is in the receptance form `U + G N(U) − G L = 0` (the element
+    /// coordinates are linearly dependent, as a planetary set's meshes are).
+    pub fn receptance_form(&self) -> bool {
+        self.linear.receptance_form
     }
 
     /// The full response `Q_j` (line-major, n DOFs per line) of the unknowns `u`.

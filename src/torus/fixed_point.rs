@@ -89,6 +89,13 @@ pub(super) fn receptance_step(
     out: &mut [Complex64],
 ) {
     let m = hb.coordinates();
+    if hb.linear.receptance_form {
+        // R = U + G N − G L already is U − G (L − N).
+        for (o, v) in out.iter_mut().zip(r) {
+            *o = -v * gamma;
+        }
+        return;
+    }
     for (j, g) in hb.linear.receptance.iter().enumerate() {
         for a in 0..m {
             let s: Complex64 = (0..m).map(|b| g[(a, b)] * r[j * m + b]).sum();

@@ -25,8 +25,11 @@ pub(super) struct TorusLinear {
     pub(super) stiffness: Vec<DMatrix<Complex64>>,
     /// `G_j = Wᵀ Z_j⁻¹ W` per line (m × m), the receptance of the fixed point.
     pub(super) receptance: Vec<DMatrix<Complex64>>,
-    /// `L_j`, line-major (`j m + c`).
+    /// `L_j`, line-major (`j m + c`); in the receptance form the linear response `G_j L_j`.
     pub(super) load: Vec<Complex64>,
+    /// The element coordinates are linearly dependent (`G_j` singular, a loop of meshes): the
+    /// balance is written `U + G N(U) − G L = 0` and `stiffness` is empty.
+    pub(super) receptance_form: bool,
 }
 
 impl TorusLinear {
@@ -47,6 +50,8 @@ impl TorusLinear {
         let mut stiffness = Vec::with_capacity(set.len());
         let mut receptance = Vec::with_capacity(set.len());
         let mut load = Vec::with_capacity(set.len() * m);
+        let mut linear_response = Vec::with_capacity(set.len() * m);
+        let mut dependent = false;
         for j in 0..set.len() {
             let nu = omega * set.ratio(j);
             let (z, scale) = dynamic_stiffness(dense, nu, augmentation.filter(|_| j == 0));
@@ -64,27 +69,33 @@ impl TorusLinear {
             }
             if m > 0 {
                 let g = wc.transpose() * rhs.columns(0, m);
-                let g_scale = g.iter().map(|v| v.norm()).fold(0.0, f64::max);
-                let g_lu = g.clone().lu();
-                receptance.push(g);
-                check_pivots(
-                    g_lu.u().diagonal().iter().map(|p| p.norm()),
-                    g_scale,
-                    || {
-                        Error::Solver {
-                        reason: format!(
-                            "torus condensation at line {:?}: the element coordinates are linearly dependent (a loop of meshes); the torus needs independent coordinates",
-                            set.k(j)
-                        ),
+                let u_lin = wc.transpose() * rhs.column(m);
+                linear_response.extend(u_lin.iter().copied());
+                if !dependent {
+                    let g_scale = g.iter().map(|v| v.norm()).fold(0.0, f64::max);
+                    let g_lu = g.clone().lu();
+                    let diagonal = g_lu.u().diagonal();
+                    let pivots = diagonal.iter().map(|p| p.norm());
+                    match check_pivots(pivots, g_scale, || singular(set, j, nu))
+                        .ok()
+                        .and_then(|_| g_lu.try_inverse())
+                    {
+                        Some(g_inv) => {
+                            load.extend((&g_inv * &u_lin).iter().copied());
+                            stiffness.push(g_inv);
+                        }
+                        // Dependent coordinates (a loop of meshes, as a planet's sun and ring
+                        // meshes with the carrier): every line in the receptance form.
+                        None => dependent = true,
                     }
-                    },
-                )?;
-                let g_inv = g_lu.try_inverse().ok_or_else(|| singular(set, j, nu))?;
-                let l = &g_inv * (wc.transpose() * rhs.column(m));
-                load.extend(l.iter().copied());
-                stiffness.push(g_inv);
+                }
+                receptance.push(g);
             }
             solved.push(rhs);
+        }
+        if dependent {
+            stiffness.clear();
+            load = linear_response;
         }
         Ok(Self {
             m,
@@ -92,12 +103,17 @@ impl TorusLinear {
             stiffness,
             receptance,
             load,
+            receptance_form: dependent,
         })
     }
 
-    /// `out_j ← G_j⁻¹ x_j` (line-major, m per line).
+    /// `out_j ← G_j⁻¹ x_j` (line-major, m per line); in the receptance form `out ← x`.
     pub(super) fn apply_stiffness(&self, x: &[Complex64], out: &mut [Complex64]) {
         let m = self.m;
+        if self.receptance_form {
+            out.copy_from_slice(x);
+            return;
+        }
         for (j, g) in self.stiffness.iter().enumerate() {
             for a in 0..m {
                 out[j * m + a] = (0..m).map(|b| g[(a, b)] * x[j * m + b]).sum();

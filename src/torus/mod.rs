@@ -51,6 +51,7 @@ mod fixed_point;
 mod gmres;
 mod grid;
 mod index_set;
+mod law_samples;
 mod linear;
 mod model;
 mod newton_krylov;

@@ -192,15 +192,33 @@ pub(super) fn finish(
 /// `P_j⁻¹` per line: the inverse of `G_j⁻¹ + diag(ḡ_u + i ν_j ḡ_u̇)`.
 fn preconditioner(hb: &TorusBalance, ws: &TorusWorkspace) -> Vec<DMatrix<Complex64>> {
     let means = hb.mean_derivatives(ws);
-    hb.linear
-        .stiffness
+    let receptance = hb.linear.receptance_form;
+    let blocks = if receptance {
+        &hb.linear.receptance
+    } else {
+        &hb.linear.stiffness
+    };
+    blocks
         .iter()
         .enumerate()
         .map(|(j, g)| {
             let nu = hb.frequency(j);
             let mut p = g.clone();
-            for (c, (a, b)) in means.iter().enumerate() {
-                p[(c, c)] += Complex64::new(*a, nu * b);
+            if receptance {
+                // I + G diag(ḡ_u + i ν ḡ_u̇)
+                for (c, (a, b)) in means.iter().enumerate() {
+                    let d = Complex64::new(*a, nu * b);
+                    for r in 0..p.nrows() {
+                        p[(r, c)] = g[(r, c)] * d;
+                    }
+                }
+                for c in 0..p.nrows() {
+                    p[(c, c)] += 1.0;
+                }
+            } else {
+                for (c, (a, b)) in means.iter().enumerate() {
+                    p[(c, c)] += Complex64::new(*a, nu * b);
+                }
             }
             p.clone().try_inverse().unwrap_or_else(|| {
                 DMatrix::from_diagonal(&p.diagonal().map(|v| {

@@ -63,6 +63,7 @@ mod options_contract;
 mod order_cuts;
 mod piecewise_exact;
 mod piecewise_exact_cli;
+mod planetary;
 mod published_lines;
 mod reference_solutions;
 mod report;

@@ -209,7 +209,7 @@ fn bad_torus_input_names_the_field() {
         ),
         (
             base.replace("teeth = 19\n", "teeth = 19\nbase = \"engine\"\n"),
-            "elements[1].base: a gear stage follows its own mesh",
+            "elements[1].base: a gear stage or planetary set follows its own mesh",
         ),
     ];
     for (scene, want) in cases {
