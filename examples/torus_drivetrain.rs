@@ -75,7 +75,11 @@ fn main() -> hbal::Result<()> {
     let t = Instant::now();
     let bound = TwoStageTrain::bind(&model)?;
     let mut hb = TorusBalance::new(bound, set, &samples, speeds[0])?;
-    let sweep = TorusSweep { solver }.run(&mut hb, &speeds, |_, _| {})?;
+    let sweep = TorusSweep {
+        solver,
+        ..Default::default()
+    }
+    .run(&mut hb, &speeds, |_, _| {})?;
     let elapsed = t.elapsed().as_secs_f64();
     let worst = sweep
         .points

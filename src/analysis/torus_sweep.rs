@@ -148,7 +148,11 @@ pub fn torus_sweep(
     let set = crate::torus::IndexSet::new(&plan.bases, &caps, plan.truncation)?;
     let mut hb = TorusBalance::new(tm, set, &samples, speeds[0])?;
     observer.stage("sweeping");
-    let result = TorusSweep { solver }.run(&mut hb, &speeds, |i, _| {
+    let result = TorusSweep {
+        solver,
+        ..Default::default()
+    }
+    .run(&mut hb, &speeds, |i, _| {
         observer.progress((i + 1) as f64 / n as f64)
     })?;
     let sol_points: Vec<TorusPointRecord> = result

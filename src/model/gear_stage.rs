@@ -222,7 +222,8 @@ impl GearStage {
                 format!(
                     "such that teeth x shaft_order ({} x {}) is a whole multiple of the \
                      fundamental's order {} (choose the fundamental so that the mesh order is a \
-                     harmonic)",
+                     harmonic, or put the scene on several base frequencies with \
+                     `harmonics.bases = \"torus\"`)",
                     self.teeth, self.shaft_order, self.fundamental_order
                 ),
             ));

@@ -36,6 +36,8 @@ pub(super) struct Speed {
     pub(super) omega: f64,
     /// `true` if the order was chosen from the engine and mesh orders.
     pub(super) chosen: bool,
+    /// `true` if the scene gives `fundamental.order`.
+    pub(super) explicit: bool,
 }
 
 impl Fundamental {
@@ -108,6 +110,7 @@ impl Fundamental {
             order,
             omega,
             chosen: self.order.is_none() && engine.is_some(),
+            explicit: self.order.is_some(),
         })
     }
 }

@@ -94,7 +94,9 @@ pub(super) fn choose(
                     .into(),
             ),
             Ok(speed) => {
-                let off = meshes.iter().find(|m| {
+                // A fundamental the scene chose itself stays: a mesh that is not its harmonic
+                // is the stage's error to fix (or `bases = "torus"`).
+                let off = meshes.iter().filter(|_| !speed.explicit).find(|m| {
                     let z = m.order / speed.order;
                     (z - z.round()).abs() > 1e-9 * z.max(1.0)
                 });

@@ -40,7 +40,7 @@ impl Default for NewtonKrylov {
     }
 }
 
-fn norm(x: &[Complex64]) -> f64 {
+pub(super) fn norm(x: &[Complex64]) -> f64 {
     x.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt()
 }
 
@@ -140,7 +140,7 @@ pub(super) fn relative_residual(hb: &TorusBalance, u: &[Complex64], r: &[Complex
 /// Backtracking along `step` from `u` (Armijo on ‖R‖ with a small slope, 12 halvings): moves
 /// `u` and its residual `r` (with the Jacobian's samples) on success; `false` (and `u`, `r`
 /// as they were) where no step lowers ‖R‖.
-fn line_search(
+pub(super) fn line_search(
     hb: &TorusBalance,
     u: &mut Vec<Complex64>,
     r: &mut Vec<Complex64>,
@@ -190,7 +190,7 @@ pub(super) fn finish(
 }
 
 /// `P_j⁻¹` per line: the inverse of `G_j⁻¹ + diag(ḡ_u + i ν_j ḡ_u̇)`.
-fn preconditioner(hb: &TorusBalance, ws: &TorusWorkspace) -> Vec<DMatrix<Complex64>> {
+pub(super) fn preconditioner(hb: &TorusBalance, ws: &TorusWorkspace) -> Vec<DMatrix<Complex64>> {
     let means = hb.mean_derivatives(ws);
     let receptance = hb.linear.receptance_form;
     let blocks = if receptance {
@@ -233,7 +233,7 @@ fn preconditioner(hb: &TorusBalance, ws: &TorusWorkspace) -> Vec<DMatrix<Complex
         .collect()
 }
 
-fn apply_blocks(blocks: &[DMatrix<Complex64>], m: usize, v: &mut [Complex64]) {
+pub(super) fn apply_blocks(blocks: &[DMatrix<Complex64>], m: usize, v: &mut [Complex64]) {
     let mut tmp = [Complex64::default(); 16];
     for (j, p) in blocks.iter().enumerate() {
         let x = &mut v[j * m..(j + 1) * m];

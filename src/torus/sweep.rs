@@ -27,11 +27,23 @@ impl TorusStability {
 
 /// A speed sweep: [`NewtonKrylov`] at every speed, warm-started from the last converged
 /// point; a point that does not converge from there is solved again from the linear response
-/// (a run-up jumps where a branch ends, as a time integration does).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// (a run-up jumps where a branch ends, as a time integration does), then by
+/// [`TorusBroyden`](super::TorusBroyden) from the warm start.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TorusSweep {
     /// The solver at each point.
     pub solver: NewtonKrylov,
+    /// Most Broyden steps at a point where Newton–Krylov fails (0: no fallback).
+    pub broyden_fallback: usize,
+}
+
+impl Default for TorusSweep {
+    fn default() -> Self {
+        Self {
+            solver: NewtonKrylov::default(),
+            broyden_fallback: 200,
+        }
+    }
 }
 
 /// The sweep's points in order, the speeds where the balance could not be set up (a line on
@@ -88,6 +100,19 @@ impl TorusSweep {
                 let fresh = self.solver.solve(hb, None)?;
                 if fresh.converged || fresh.relative_residual < sol.relative_residual {
                     sol = fresh;
+                }
+            }
+            if !sol.converged && self.broyden_fallback > 0 {
+                // Broyden's secant steps get through some places where a contact opens and
+                // Newton's line search stalls.
+                let broyden = super::TorusBroyden {
+                    tolerance: self.solver.tolerance,
+                    max_iterations: self.broyden_fallback,
+                    ..Default::default()
+                };
+                let b = broyden.solve(hb, start.as_deref())?;
+                if b.converged || b.relative_residual < sol.relative_residual {
+                    sol = b;
                 }
             }
             if sol.converged {

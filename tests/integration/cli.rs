@@ -19,10 +19,7 @@ fn every_example_scene_solves_and_checks() {
             "check {p}: {}",
             String::from_utf8_lossy(&out.stderr)
         );
-        if std::fs::read_to_string(&path)
-            .unwrap()
-            .contains("bases = \"torus\"")
-        {
+        if hbal::scene::Scene::load(&path).unwrap().torus.is_some() {
             continue; // on several base frequencies: tests/integration/torus_cli.rs
         }
         let out = hbal(&["solve", p, "--json"]);

@@ -237,7 +237,7 @@ dofs = ["pinion", "gear"]
 mass = [[1e-3, 0.0], [0.0, 4e-3]]
 stiffness = [[1e4, 0.0], [0.0, 4e4]]
 fundamental = { rpm = 3000 }
-harmonics = { count = 8 }
+harmonics = { count = 8, bases = "one" }
 loads = [{ dof = "pinion", order = 0, cos = 20.0 }]
 [[elements]]
 name = "mesh"

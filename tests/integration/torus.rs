@@ -218,7 +218,7 @@ fn commensurate_train_equals_one_frequency_for_every_phasing() {
 
 /// [`two_stage`] with a torque ripple of `ripple` N m at the stage-1 mesh frequency on `in`
 /// (order `ripple_order` of the law's angle).
-fn two_stage_rippled(teeth: [u32; 2], ripple_order: usize, ripple: f64) -> Model {
+pub(crate) fn two_stage_rippled(teeth: [u32; 2], ripple_order: usize, ripple: f64) -> Model {
     let base = two_stage(teeth, 0.0);
     let mut b = Model::builder(&["in", "mid", "out"]).mass_diagonal(&[0.05, 0.02, 0.08]);
     for e in base.elements() {
