@@ -40,6 +40,7 @@ pub(crate) mod sweep_command;
 mod sweep_files;
 pub(crate) mod sweep_summary;
 mod sweep_text;
+pub(crate) mod torus_report;
 pub(crate) mod torus_solve;
 pub(crate) mod torus_sweep;
 

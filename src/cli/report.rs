@@ -58,8 +58,12 @@ impl<T> Part<T> {
 }
 
 pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Result<u8, Failure> {
-    let scene = check(path, args, &opts)?;
+    let scene = super::load(path, args)?;
     let scene_text = std::fs::read_to_string(path).unwrap_or_default();
+    if scene.torus.is_some() {
+        return super::torus_report::report(&scene, &scene_text, &opts);
+    }
+    let scene = check(scene, &opts)?;
     let dir = opts.out;
     eprintln!("report: solving {} at its speed", scene.file);
     let solved = solve_part(&scene, args, &opts);
@@ -106,8 +110,7 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
 }
 
 /// Bad input first: the scene, the speed range, the output name and --out.
-fn check(path: &Path, args: &SolverArgs, opts: &ReportOptions) -> Result<Scene, Failure> {
-    let scene = super::load(path, args)?;
+fn check(scene: Scene, opts: &ReportOptions) -> Result<Scene, Failure> {
     if opts.from.is_some() && opts.to.is_none() {
         return Err(anyhow::anyhow!("--from needs --to (the run-up's end speed)").into());
     }

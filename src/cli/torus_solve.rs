@@ -37,9 +37,7 @@ pub(crate) fn solve(scene: &Scene, json: bool, out: Option<&Path>) -> Result<u8,
         print(scene, &a);
     }
     if let Some(dir) = out {
-        write_lines(&dir.join("lines.csv"), &a)
-            .with_context(|| format!("--out: cannot write {}", dir.display()))?;
-        plot_spectrum(&dir.join("spectrum.svg"), scene, &a);
+        write_files(dir, scene, &a)?;
         if !json {
             say!("  wrote lines.csv, spectrum.svg to {}", dir.display());
         }
@@ -57,6 +55,18 @@ pub(crate) fn solve(scene: &Scene, json: bool, out: Option<&Path>) -> Result<u8,
         );
     }
     Ok(a.exit_code())
+}
+
+/// `lines.csv` and `spectrum.svg` into `dir`.
+pub(crate) fn write_files(
+    dir: &Path,
+    scene: &Scene,
+    a: &TorusSolveAnalysis,
+) -> Result<(), Failure> {
+    write_lines(&dir.join("lines.csv"), a)
+        .with_context(|| format!("--out: cannot write {}", dir.display()))?;
+    plot_spectrum(&dir.join("spectrum.svg"), scene, a);
+    Ok(())
 }
 
 /// The summary.

@@ -24,6 +24,35 @@ pub(crate) struct TorusSweepOptions<'a> {
 
 /// Sweeps, prints and writes; the exit code of the analysis.
 pub(crate) fn sweep(scene: &Scene, opts: TorusSweepOptions) -> Result<u8, Failure> {
+    let (json, out) = (opts.json, opts.out);
+    let a = run(scene, opts)?;
+    if json {
+        say!(
+            "{}",
+            serde_json::to_string(&a).context("JSON of the sweep")?
+        );
+    } else {
+        print(scene, &a);
+        if let Some(dir) = out {
+            say!(
+                "  wrote points.csv, order_cuts.csv, order_cuts.svg, waterfall.svg to {}",
+                dir.display()
+            );
+        }
+    }
+    if a.failures() > 0 {
+        eprintln!(
+            "error: {}: {} of {} points did not converge or could not be set up (marked in points.csv and the JSON)",
+            scene.file,
+            a.failures(),
+            a.points.len() + a.skipped.len()
+        );
+    }
+    Ok(a.exit_code())
+}
+
+/// Checks the options, sweeps (a progress bar unless `json`) and writes the files of `out`.
+pub(crate) fn run(scene: &Scene, opts: TorusSweepOptions) -> Result<TorusSweepAnalysis, Failure> {
     let elements = scene.model.elements();
     let shown = match opts.output {
         None => elements.first().map(|e| e.name().to_string()),
@@ -55,33 +84,11 @@ pub(crate) fn sweep(scene: &Scene, opts: TorusSweepOptions) -> Result<u8, Failur
     let a = hbal::analysis::torus_sweep(scene, &settings, &mut &progress)
         .map_err(|e| super::failure(e, &scene.file))?;
     progress.finish();
-    if opts.json {
-        say!(
-            "{}",
-            serde_json::to_string(&a).context("JSON of the sweep")?
-        );
-    } else {
-        print(scene, &a);
-    }
     if let Some(dir) = opts.out {
         write_files(dir, scene, &a, shown.as_deref())
             .with_context(|| format!("--out: cannot write {}", dir.display()))?;
-        if !opts.json {
-            say!(
-                "  wrote points.csv, order_cuts.csv, order_cuts.svg, waterfall.svg to {}",
-                dir.display()
-            );
-        }
     }
-    if a.failures() > 0 {
-        eprintln!(
-            "error: {}: {} of {} points did not converge or could not be set up (marked in points.csv and the JSON)",
-            scene.file,
-            a.failures(),
-            a.points.len() + a.skipped.len()
-        );
-    }
-    Ok(a.exit_code())
+    Ok(a)
 }
 
 fn print(scene: &Scene, a: &TorusSweepAnalysis) {

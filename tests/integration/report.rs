@@ -283,3 +283,58 @@ fn sweep_output_chooses_the_plotted_output() {
     let cuts = std::fs::read_to_string(dir.join("order_cuts.svg")).unwrap();
     assert!(cuts.contains("Order cuts of the DOF pinion"));
 }
+
+/// A scene on several base frequencies gets its own report: the bases with their truncation
+/// estimates, every element's labelled lines (the numbers of `hbal solve --json`), the run-up's
+/// order cuts and waterfall, rendered in a real browser.
+#[test]
+fn report_of_a_torus_scene_holds_its_labelled_lines_and_renders() {
+    let dir = fresh_dir("report_torus");
+    let file = scene("two_stage_train_torus.toml");
+    let out = hbal(&[
+        "report",
+        &file,
+        "--from",
+        "2000",
+        "--to",
+        "2100",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let solved = hbal(&["solve", &file, "--json"]);
+    let doc: serde_json::Value = serde_json::from_slice(&solved.stdout).unwrap();
+    let top = &doc["elements"][0]["lines"][0];
+    assert_eq!(top["label"], "3 stage1");
+    let amplitude = format!("<td>{:.4e}</td>", top["amplitude"].as_f64().unwrap());
+    assert!(html.contains(&amplitude), "{amplitude} in the stage1 table");
+    for needle in [
+        "Element stage1",
+        "Element stage2",
+        "3 stage1 − stage2",
+        "truncation estimate",
+        "Run-up",
+        "Order cuts",
+        "Waterfall",
+        "Stability: not computed",
+    ] {
+        assert!(html.contains(needle), "{needle}");
+    }
+    for f in [
+        "solve/lines.csv",
+        "solve/spectrum.svg",
+        "sweep/order_cuts.csv",
+        "sweep/waterfall.svg",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    if let Some((plots, rendered)) = rendered_plots(&dir.join("report.html")) {
+        assert_eq!((plots, rendered), (3, 3), "spectrum, order cuts, waterfall");
+    }
+}

@@ -143,7 +143,14 @@ fn flags_of_one_fundamental_are_refused_on_the_torus() {
         vec!["sweep", &p, "--to", "3000", "--all-branches"],
         vec!["sweep", &p, "--to", "3000", "--output", "crank"],
         vec!["sweep", &p, "--to", "3000", "--points", "1"],
-        vec!["report", &p],
+        vec![
+            "report",
+            &p,
+            "--out",
+            "/nonexistent-hbal-dir/x",
+            "--from",
+            "1000",
+        ],
         vec!["compare", &p],
     ] {
         let out = hbal(&args);

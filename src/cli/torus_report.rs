@@ -1,0 +1,250 @@
+//! `hbal report` of a scene on several base frequencies: one self-contained `report.html` with
+//! the bases and their truncation estimates, every element's transmission-error and force lines
+//! labelled by their combination, the DOFs, the spectrum, and with `--to` the run-up's order
+//! cuts, waterfall (sidebands included) and the points that did not converge. The parts' files
+//! go to `DIR/solve` and `DIR/sweep` as `hbal solve` and `hbal sweep` write them.
+
+use super::report::ReportOptions;
+use super::Failure;
+use hbal::analysis::{Spectrum, TorusSolveAnalysis, TorusSolveSettings, TorusSweepAnalysis};
+use hbal::report::HtmlReport;
+use hbal::scene::Scene;
+
+/// Points of the report's run-up.
+const RUN_UP_POINTS: usize = 101;
+
+/// Lines per element in the report's tables.
+const TABLE_LINES: usize = 8;
+
+pub(crate) fn report(scene: &Scene, scene_text: &str, opts: &ReportOptions) -> Result<u8, Failure> {
+    if opts.from.is_some() && opts.to.is_none() {
+        return Err(anyhow::anyhow!("--from needs --to (the run-up's end speed)").into());
+    }
+    let dir = opts.out;
+    super::prepare_out(dir, &["report.html".to_string()])?;
+    super::prepare_out(
+        &dir.join("solve"),
+        &["lines.csv".into(), "spectrum.svg".into()],
+    )?;
+    eprintln!(
+        "report: solving {} at its speed on several base frequencies",
+        scene.file
+    );
+    let solved = hbal::analysis::torus_solve(scene, &TorusSolveSettings::default())
+        .map_err(|e| super::failure(e, &scene.file))?;
+    super::torus_solve::write_files(&dir.join("solve"), scene, &solved)?;
+    let swept = match opts.to {
+        None => None,
+        Some(to) => {
+            eprintln!(
+                "report: run-up to {} {}",
+                super::speed_text(to),
+                scene.speed_unit
+            );
+            let options = super::torus_sweep::TorusSweepOptions {
+                from: opts.from,
+                to,
+                points: RUN_UP_POINTS,
+                json: true,
+                out: Some(&dir.join("sweep")),
+                output: opts.output,
+            };
+            Some(super::torus_sweep::run(scene, options)?)
+        }
+    };
+    let mut page = HtmlReport::new(&format!("hbal report: {}", scene.file));
+    overview(&mut page, scene, scene_text, &solved);
+    for (coordinate, force) in solved.elements.iter().zip(&solved.forces) {
+        page.heading(&format!("Element {}", coordinate.name));
+        lines_table(
+            &mut page,
+            "coordinate (a gear stage: transmission error, m)",
+            coordinate,
+        );
+        lines_table(&mut page, "force (a gear stage: mesh force, N)", force);
+    }
+    page.heading("DOFs");
+    let rows: Vec<Vec<String>> = solved
+        .dofs
+        .iter()
+        .map(|s| {
+            let top = s.lines.first();
+            vec![
+                s.name.clone(),
+                format!("{:.4e}", s.mean),
+                format!("{:.4e}", s.rms),
+                top.map_or(String::new(), |l| l.label.clone()),
+                top.map_or(String::new(), |l| format!("{:.4e}", l.amplitude)),
+            ]
+        })
+        .collect();
+    page.table(
+        &[
+            "DOF",
+            "mean",
+            "RMS (alternating)",
+            "strongest line",
+            "its amplitude",
+        ],
+        &rows,
+    );
+    figure(
+        &mut page,
+        &dir.join("solve/spectrum.svg"),
+        "Lines of the element coordinates",
+    );
+    if let Some(a) = &swept {
+        run_up(&mut page, dir, a);
+    }
+    let file = dir.join("report.html");
+    std::fs::write(&file, page.finish())
+        .map_err(|e| anyhow::anyhow!("--out: cannot write {}: {e}", file.display()))?;
+    say!("wrote {}", file.display());
+    let code = solved
+        .exit_code()
+        .max(swept.as_ref().map_or(0, |a| a.exit_code()));
+    Ok(code)
+}
+
+fn overview(page: &mut HtmlReport, scene: &Scene, scene_text: &str, a: &TorusSolveAnalysis) {
+    page.facts(&[
+        ("scene", scene.file.clone()),
+        ("description", scene.description.clone().unwrap_or_default()),
+        (
+            "speed",
+            format!("{} {}", super::speed_text(a.speed), a.speed_unit),
+        ),
+        ("basis", format!("several base frequencies: {}", a.why)),
+        ("lines", a.lines.to_string()),
+        ("relative residual", format!("{:.1e}", a.relative_residual)),
+    ]);
+    let ok = a.converged && a.caps_stopped.is_none();
+    let text = match (&a.caps_stopped, a.converged) {
+        (Some(why), _) => format!("automatic caps stopped above the tolerance: {why}"),
+        (None, true) => "converged".to_string(),
+        (None, false) => "NOT CONVERGED: the lines below are the last iterate".to_string(),
+    };
+    page.status(ok, &text);
+    let rows: Vec<Vec<String>> = a
+        .bases
+        .iter()
+        .map(|b| {
+            vec![
+                b.name.clone(),
+                super::speed_text(b.order),
+                format!("{:.2}", b.hz),
+                b.cap.to_string(),
+                b.samples.to_string(),
+                b.estimate
+                    .map_or("not estimated".into(), |e| format!("{e:.1e}")),
+            ]
+        })
+        .collect();
+    page.table(
+        &["base", "order", "Hz", "cap", "grid", "truncation estimate"],
+        &rows,
+    );
+    let hbal::torus::TorusStability::NotComputed { reason } = &a.stability;
+    page.paragraph(&format!("Stability: {reason}"));
+    page.details("scene file", scene_text);
+}
+
+fn lines_table(page: &mut HtmlReport, what: &str, s: &Spectrum) {
+    page.paragraph(&format!(
+        "{what}: mean {:.4e}, RMS of the alternating part {:.4e}",
+        s.mean, s.rms
+    ));
+    let rows: Vec<Vec<String>> = s
+        .lines
+        .iter()
+        .take(TABLE_LINES)
+        .map(|l| {
+            vec![
+                l.label.clone(),
+                super::speed_text(l.order),
+                format!("{:.2}", l.hz),
+                format!("{:.4e}", l.amplitude),
+                format!("{:.1}", l.phase.to_degrees()),
+            ]
+        })
+        .collect();
+    page.table(&["line", "order", "Hz", "amplitude", "phase (deg)"], &rows);
+}
+
+fn run_up(page: &mut HtmlReport, dir: &std::path::Path, a: &TorusSweepAnalysis) {
+    page.heading("Run-up");
+    let failures = a.failures();
+    page.status(
+        failures == 0,
+        &format!(
+            "{} points, {failures} not converged or skipped (marked in sweep/points.csv)",
+            a.points.len()
+        ),
+    );
+    let rows: Vec<Vec<String>> = a
+        .points
+        .iter()
+        .filter(|p| !p.converged)
+        .map(|p| {
+            vec![
+                super::speed_text(p.speed),
+                format!("{:.1e}", p.relative_residual),
+            ]
+        })
+        .chain(
+            a.skipped
+                .iter()
+                .map(|(s, why)| vec![super::speed_text(*s), why.clone()]),
+        )
+        .collect();
+    if !rows.is_empty() {
+        page.table(
+            &[
+                &format!("speed ({})", a.speed_unit),
+                "relative residual / reason",
+            ],
+            &rows,
+        );
+    }
+    let rows: Vec<Vec<String>> = a
+        .order_cuts
+        .iter()
+        .map(|c| {
+            vec![
+                c.element.clone(),
+                c.label.clone(),
+                super::speed_text(c.order),
+                format!("{:.4e}", c.peak.0),
+                super::speed_text(c.peak.1),
+            ]
+        })
+        .collect();
+    page.table(
+        &[
+            "element",
+            "line",
+            "order",
+            "peak",
+            &format!("at ({})", a.speed_unit),
+        ],
+        &rows,
+    );
+    figure(page, &dir.join("sweep/order_cuts.svg"), "Order cuts");
+    figure(
+        page,
+        &dir.join("sweep/waterfall.svg"),
+        "Waterfall: every line at its order, sidebands grey",
+    );
+}
+
+/// Inlines the SVG at `path`, or says why not.
+fn figure(page: &mut HtmlReport, path: &std::path::Path, caption: &str) {
+    match std::fs::read_to_string(path) {
+        Ok(svg) => {
+            if let Err(e) = page.figure(&svg, caption) {
+                page.paragraph(&e);
+            }
+        }
+        Err(_) => page.paragraph(&format!("{caption}: no plot (nothing finite to draw)")),
+    }
+}
