@@ -41,6 +41,7 @@
 //! ```
 
 mod anderson;
+mod arclength;
 mod auto_caps;
 mod balance;
 mod bases;
@@ -60,6 +61,7 @@ mod solution;
 mod sweep;
 
 pub use anderson::TorusAnderson;
+pub use arclength::{TorusArclength, TorusBranch};
 pub use auto_caps::{AutoCaps, AutoCapsOutcome, CapsLevel};
 pub use balance::{TorusBalance, TorusWorkspace};
 pub use bases::Bases;

@@ -82,6 +82,7 @@ mod stability_worker;
 mod tail_correction;
 mod threads;
 mod torus;
+mod torus_arclength;
 mod torus_broyden;
 mod torus_cli;
 mod torus_scene;
