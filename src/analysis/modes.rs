@@ -88,6 +88,30 @@ pub fn excitation_orders(scene: &Scene, basis: &HarmonicBasis) -> Vec<(f64, usiz
     ks.into_iter().map(|k| (k as f64 * f, k)).collect()
 }
 
+/// The excitation orders of a scene on several base frequencies: each load's and each law's
+/// time order times its base's order of the speed.
+fn torus_orders(scene: &Scene, plan: &crate::scene::TorusPlan) -> Result<Vec<f64>> {
+    let tm = plan.bind(&scene.model)?;
+    let ratios = plan.bases.ratios();
+    let loads = scene
+        .model
+        .loads()
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.order > 0)
+        .map(|(i, l)| l.order as f64 * ratios[tm.load_base(i)]);
+    let elements = scene.model.elements().iter().enumerate();
+    let meshes = elements.filter_map(|(e, el)| {
+        el.law()
+            .time_order()
+            .map(|z| z as f64 * ratios[tm.element_base(e)])
+    });
+    let mut orders: Vec<f64> = loads.chain(meshes).collect();
+    orders.sort_by(f64::total_cmp);
+    orders.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
+    Ok(orders)
+}
+
 /// The modes of `scene` about its periodic solution (module documentation).
 ///
 /// # Errors
@@ -126,10 +150,13 @@ pub fn modes(scene: &Scene, settings: &ModesSettings) -> Result<ModesAnalysis> {
         None => 5000.0,
     };
     let (termination, natural, linear) = operating_point(scene, settings, max_hz)?;
-    let orders: Vec<f64> = excitation_orders(scene, &scene.basis)
-        .into_iter()
-        .map(|(o, _)| o)
-        .collect();
+    let orders: Vec<f64> = match &scene.torus {
+        Some(plan) => torus_orders(scene, plan)?,
+        None => excitation_orders(scene, &scene.basis)
+            .into_iter()
+            .map(|(o, _)| o)
+            .collect(),
+    };
     let per_unit = scene.omega_per_speed / scene.fundamental_order;
     // Without an operating point (and `--to`), up to a quarter above the highest critical speed.
     let to = match (&natural, settings.to, scene.operating_point) {

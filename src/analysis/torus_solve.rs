@@ -27,8 +27,8 @@ pub struct BaseRecord {
     pub name: String,
     /// Its order of the speed.
     pub order: f64,
-    /// Its frequency at the speed, Hz.
-    pub hz: f64,
+    /// Its frequency at the speed, Hz (`None` in a sweep).
+    pub hz: Option<f64>,
     /// Its cap.
     pub cap: usize,
     /// Its grid points.
@@ -182,7 +182,7 @@ fn analysis_of(
         .map(|b| BaseRecord {
             name: plan.bases.names()[b].clone(),
             order: plan.bases.ratios()[b],
-            hz: plan.bases.ratios()[b] * sol.omega / std::f64::consts::TAU,
+            hz: Some(plan.bases.ratios()[b] * sol.omega / std::f64::consts::TAU),
             cap: outcome.caps[b],
             samples: outcome.samples[b],
             estimate: sol.truncation[b],

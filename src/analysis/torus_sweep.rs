@@ -7,7 +7,9 @@ use super::torus_solve::{plan_of, BaseRecord};
 use super::Observer;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
-use crate::torus::{NewtonKrylov, TorusBalance, TorusSolution, TorusStability, TorusSweep};
+use crate::torus::{
+    NewtonKrylov, TorusBalance, TorusSolution, TorusStability, TorusSweep, Truncation,
+};
 
 /// Order cuts kept per element coordinate.
 pub const CUTS_PER_ELEMENT: usize = 8;
@@ -51,7 +53,8 @@ pub struct OrderCut {
     pub order: f64,
     /// Its amplitude at every point of `points`.
     pub amplitudes: Vec<f64>,
-    /// The largest amplitude and the speed of that point.
+    /// The largest amplitude over the converged points and the speed of that point (NaN
+    /// where none converged).
     pub peak: (f64, f64),
 }
 
@@ -135,6 +138,7 @@ pub fn torus_sweep(
     };
     // Automatic caps: the largest the ends of the range need, for the whole sweep.
     let (mut caps, mut samples) = (plan.caps.clone(), plan.samples.clone());
+    let mut truncation = plan.truncation;
     if let Some(auto) = &plan.auto {
         observer.stage("choosing the caps at both ends");
         for w in [speeds[0], speeds[n - 1]] {
@@ -143,9 +147,15 @@ pub fn torus_sweep(
                 caps[b] = caps[b].max(o.caps[b]);
                 samples[b] = samples[b].max(o.samples[b]);
             }
+            // A diamond's total grows with the caps: the larger of the two ends.
+            if let (Truncation::Diamond { total: a }, Truncation::Diamond { total: b }) =
+                (truncation, o.truncation)
+            {
+                truncation = Truncation::Diamond { total: a.max(b) };
+            }
         }
     }
-    let set = crate::torus::IndexSet::new(&plan.bases, &caps, plan.truncation)?;
+    let set = crate::torus::IndexSet::new(&plan.bases, &caps, truncation)?;
     let mut hb = TorusBalance::new(tm, set, &samples, speeds[0])?;
     observer.stage("sweeping");
     let result = TorusSweep {
@@ -177,7 +187,7 @@ pub fn torus_sweep(
             BaseRecord {
                 name: plan.bases.names()[b].clone(),
                 order: plan.bases.ratios()[b],
-                hz: f64::NAN,
+                hz: None,
                 cap: caps[b],
                 samples: samples[b],
                 estimate: worst,
@@ -218,8 +228,11 @@ fn order_cuts(scene: &Scene, points: &[TorusSolution], per: f64) -> Vec<OrderCut
                     .collect()
             })
             .collect();
+        // Peaks over the converged points only (an unconverged iterate's lines are marked in
+        // the points, never reported as a peak).
         let peak = |j: usize| {
             (0..points.len())
+                .filter(|&i| points[i].converged)
                 .map(|i| (lines[i][j], points[i].omega / per))
                 .fold((0.0, f64::NAN), |a, b| if b.0 > a.0 { b } else { a })
         };

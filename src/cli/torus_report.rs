@@ -132,7 +132,7 @@ fn overview(page: &mut HtmlReport, scene: &Scene, scene_text: &str, a: &TorusSol
             vec![
                 b.name.clone(),
                 super::speed_text(b.order),
-                format!("{:.2}", b.hz),
+                format!("{:.2}", b.hz.unwrap_or(f64::NAN)),
                 b.cap.to_string(),
                 b.samples.to_string(),
                 b.estimate

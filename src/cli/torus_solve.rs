@@ -85,7 +85,7 @@ fn print(scene: &Scene, a: &TorusSolveAnalysis) {
             "  {:<10} {:>8} {:>9.2} {:>4} {:>5}  {}",
             b.name,
             super::speed_text(b.order),
-            b.hz,
+            b.hz.unwrap_or(f64::NAN),
             b.cap,
             b.samples,
             b.estimate

@@ -181,6 +181,7 @@ fn write_files(
         "line".into(),
         "order".into(),
         "amplitude".into(),
+        "converged".into(),
     ])?;
     for c in &a.order_cuts {
         for (p, amp) in a.points.iter().zip(&c.amplitudes) {
@@ -190,6 +191,7 @@ fn write_files(
                 c.label.clone(),
                 format!("{:e}", c.order),
                 format!("{amp:e}"),
+                p.converged.to_string(),
             ])?;
         }
     }

@@ -178,7 +178,17 @@ impl PlanetarySet {
                 ));
             }
         }
-        let [_, rp, rr] = self.base_radii;
+        let [rs, rp, rr] = self.base_radii;
+        // Meshing gears share one base pitch 2π r_b / z: sun and ring through the planet.
+        let (ps, pr) = (rs / f64::from(zs), rr / f64::from(zr));
+        if (ps - pr).abs() > 1e-3 * ps.max(pr) {
+            return Err(Error::invalid(
+                context,
+                "base_radii[2]",
+                rr,
+                format!("{:.6e} m, the sun's base radius per tooth r_s / z_s = {ps:.6e} times the ring's {zr} teeth (sun and ring mesh with the same planets, so they share one base pitch)", ps * f64::from(zr)),
+            ));
+        }
         if rr <= rp {
             return Err(Error::invalid(
                 context,

@@ -311,11 +311,17 @@ impl SceneFile {
                 let f0 = fundamental
                     .speed(self.engine.as_ref(), &[])
                     .map_err(|(path, message)| err(&path, message))?;
+                // `harmonics.count` covers `count × f / f0` harmonics of the first base.
+                let count_cap = self.harmonics.as_ref().and_then(|h| h.count).map(|h| {
+                    let f = one.as_ref().map_or(f0.order, |s| s.order);
+                    (h as f64 * f / f0.order).floor() as usize
+                });
                 let layout = torus_plan::Layout::new(
                     &mut elements,
                     &meshes,
                     f0.order,
                     self.engine.is_some(),
+                    count_cap,
                     why,
                 )
                 .map_err(|(path, message)| err(&path, message))?;

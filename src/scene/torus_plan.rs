@@ -132,6 +132,9 @@ pub(super) struct Layout {
     /// `(table name, order)` of every gear stage and planetary set: the order its meshes
     /// count against.
     orders: Vec<(String, f64)>,
+    /// The first base's cap that `harmonics.count` stands for (the harmonics of one
+    /// fundamental it covers), where given.
+    count_cap: Option<usize>,
     why: String,
 }
 
@@ -144,6 +147,7 @@ impl Layout {
         meshes: &[Mesh],
         f0: f64,
         engine: bool,
+        count_cap: Option<usize>,
         why: String,
     ) -> Result<Self, FieldError> {
         let first = if engine { "engine" } else { "shaft" };
@@ -152,6 +156,7 @@ impl Layout {
             ratios: vec![f0],
             bindings: Vec::new(),
             orders: Vec::new(),
+            count_cap,
             why,
         };
         for m in meshes {
@@ -162,10 +167,18 @@ impl Layout {
             let b = match same {
                 Some(b) => b,
                 None if layout.names.contains(&m.name) => {
+                    let other = if layout.names[0] == m.name {
+                        "the engine's or shaft's base".to_string()
+                    } else {
+                        "the base of another gear stage or planetary set".to_string()
+                    };
                     return Err((
                         format!("elements[{}].name", m.index),
-                        format!("`{}` is also the name of the torus base of the engine or shaft: rename the stage", m.name),
-                    ))
+                        format!(
+                            "`{}` is also the name of {other}: give every stage its own name",
+                            m.name
+                        ),
+                    ));
                 }
                 None => {
                     layout.names.push(m.name.clone());
@@ -259,7 +272,21 @@ impl Layout {
         };
         known(&harmonics.caps, "caps")?;
         known(&harmonics.grid, "grid")?;
-        let first = model.max_load_order().max(4);
+        // `count`'s harmonics, but below the first mesh's order: beyond it the first base
+        // would repeat the mesh's lines (and meet them in a combination of frequency zero).
+        let below_meshes = self.ratios[1..]
+            .iter()
+            .map(|r| {
+                ((r / self.ratios[0]).ceil() as usize)
+                    .saturating_sub(1)
+                    .max(1)
+            })
+            .min()
+            .unwrap_or(usize::MAX);
+        let first = model
+            .max_load_order()
+            .max(4)
+            .max(self.count_cap.unwrap_or(0).min(below_meshes));
         let caps: Vec<usize> = self
             .names
             .iter()
@@ -303,10 +330,12 @@ impl Layout {
             auto: harmonics.torus_auto()?,
             tolerance: crate::torus::NewtonKrylov::default().tolerance,
         };
-        plan.index_set()
+        let set = plan
+            .index_set()
             .map_err(|e| ("harmonics.caps".to_string(), e.to_string()))?;
         plan.grid_size()
             .map_err(|e| ("harmonics.grid".to_string(), e))?;
+        plan.check_orders(model, &set)?;
         Ok(plan)
     }
 }
@@ -351,6 +380,59 @@ impl TorusPlan {
             .try_fold(TorusModel::new(model, self.bases.clone()), |tm, (e, b)| {
                 tm.bind_element(e, &names[*b])
             })
+    }
+
+    /// Every load's order and every law's time order is a line of `set`, or the error names
+    /// the cap or the total that leaves it out.
+    fn check_orders(&self, model: &Model, set: &IndexSet) -> Result<(), FieldError> {
+        let tm = self
+            .bind(model)
+            .map_err(|e| ("elements".to_string(), e.to_string()))?;
+        let d = self.bases.len();
+        let loads = model
+            .loads()
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.order > 0)
+            .map(|(i, l)| {
+                let what = format!(
+                    "the load on `{}` at order {}",
+                    model.dof_names()[l.dof],
+                    l.order
+                );
+                (what, l.order, tm.load_base(i))
+            });
+        let laws = model.elements().iter().enumerate().filter_map(|(e, el)| {
+            let z = el.law().time_order()?;
+            Some((
+                format!("element `{}`, which varies at order {z}", el.name()),
+                z,
+                tm.element_base(e),
+            ))
+        });
+        for (what, order, b) in loads.chain(laws) {
+            let mut k = vec![0i32; d];
+            k[b] = i32::try_from(order).unwrap_or(i32::MAX);
+            if set.contains_either_sign(&k) {
+                continue;
+            }
+            let name = &self.bases.names()[b];
+            return Err(if order > self.caps[b] {
+                (
+                    format!("harmonics.caps.{name}"),
+                    format!(
+                        "must be at least {order} for {what} of base `{name}`, got {}",
+                        self.caps[b]
+                    ),
+                )
+            } else {
+                (
+                    "harmonics.total".to_string(),
+                    format!("must be at least {order} for {what} of base `{name}`"),
+                )
+            });
+        }
+        Ok(())
     }
 
     fn grid_size(&self) -> Result<(), String> {

@@ -95,6 +95,23 @@ impl AutoCaps {
                 estimates: solution.truncation.clone(),
                 converged: solution.converged,
             });
+            if !solution.converged {
+                // A usable converged level is not thrown away for a failed finer one.
+                if let Some((old, prior)) = previous {
+                    let last = &levels[levels.len() - 2];
+                    return Ok(AutoCapsOutcome {
+                        stopped: Some(format!(
+                            "the solve at caps {caps:?} did not converge; the caps {:?} before it are reported",
+                            last.caps
+                        )),
+                        caps: last.caps.clone(),
+                        samples: last.samples.clone(),
+                        truncation: old.truncation(),
+                        solution: prior,
+                        levels,
+                    });
+                }
+            }
             let raise =
                 match self.verdict(&solution, &caps, &samples, tm.bases().names(), levels.len()) {
                     Ok(raise) if !raise.is_empty() => raise,

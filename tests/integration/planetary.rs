@@ -210,3 +210,21 @@ fn bad_planetary_input_names_the_field() {
         assert!(err.contains(want), "{want}: {err}");
     }
 }
+
+/// `hbal modes` of the set on the torus: the mesh's order of the speed (18.49), not its
+/// harmonic of its own base.
+#[test]
+fn modes_on_the_torus_name_the_mesh_order() {
+    let text = scene_text()
+        .replace("  { dof = \"motor\", order = 1, cos = 2.0 },\n", "")
+        .replace("  { dof = \"motor\", order = 2, sin = 1.5 },\n", "");
+    let scene = Scene::from_str(&text, "p.toml").unwrap();
+    assert!(scene.torus.is_some());
+    let a = hbal::analysis::modes(&scene, &hbal::analysis::ModesSettings::default()).unwrap();
+    assert_eq!(a.orders.len(), 1, "{:?}", a.orders);
+    assert!(
+        (a.orders[0] - 25.0 * 71.0 / 96.0).abs() < 1e-12,
+        "{:?}",
+        a.orders
+    );
+}

@@ -102,7 +102,7 @@ fn sweep_writes_order_cuts_and_a_waterfall_and_marks_failures() {
     let cuts = std::fs::read_to_string(dir.join("order_cuts.csv")).unwrap();
     assert_eq!(
         cuts.lines().next().unwrap(),
-        "speed_rpm,element,line,order,amplitude"
+        "speed_rpm,element,line,order,amplitude,converged"
     );
     assert_eq!(
         cuts.lines().count(),
@@ -126,6 +126,21 @@ fn sweep_writes_order_cuts_and_a_waterfall_and_marks_failures() {
         .filter(|p| p["converged"] == false)
         .count();
     assert!(failed > 0, "{doc}");
+    // Peaks come from converged points only.
+    let converged: Vec<f64> = doc["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["converged"] == true)
+        .map(|p| p["speed"].as_f64().unwrap())
+        .collect();
+    for c in doc["order_cuts"].as_array().unwrap() {
+        let at = &c["peak"][1];
+        assert!(
+            at.is_null() || converged.contains(&at.as_f64().unwrap()),
+            "{c}"
+        );
+    }
     assert!(
         stderr(&out).contains("did not converge"),
         "{}",

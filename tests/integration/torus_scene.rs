@@ -211,6 +211,18 @@ fn bad_torus_input_names_the_field() {
             base.replace("teeth = 19\n", "teeth = 19\nbase = \"engine\"\n"),
             "elements[1].base: a gear stage or planetary set follows its own mesh",
         ),
+        (
+            base.replace(caps, &format!("{caps}, total = 3")),
+            "harmonics.total: must be at least 4 for the load on `crank` at order 4 of base `engine`",
+        ),
+        (
+            base.replace(caps, "caps = { engine = 6, stage1 = 4, stage2 = 4 }"),
+            "harmonics.caps.engine: must be at least 8 for the load on `crank` at order 8",
+        ),
+        (
+            base.replace("name = \"stage2\"", "name = \"stage1\""),
+            "`stage1` is also the name of the base of another gear stage",
+        ),
     ];
     for (scene, want) in cases {
         let err = scene_error(&scene);
@@ -234,6 +246,13 @@ fn bad_torus_input_names_the_field() {
         "{}",
         scene_error(&on)
     );
+    // `count` on the torus is the first base's cap (the harmonics of one fundamental it covers).
+    let counted = duffing.replace("harmonics = {", "harmonics = { bases = \"torus\",");
+    let plan = Scene::from_str(&counted, "duffing.toml")
+        .unwrap()
+        .torus
+        .unwrap();
+    assert_eq!(plan.caps, [7]);
     // Overrides of one fundamental are refused on the torus; the tolerance applies.
     let mut scene = Scene::load(std::path::Path::new(&scene_path(
         "two_stage_train_torus.toml",
