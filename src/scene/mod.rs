@@ -46,6 +46,7 @@ mod set_parameter;
 pub use set_parameter::set_parameter;
 mod planetary;
 mod solver;
+mod torus_choice;
 mod torus_plan;
 
 pub use overrides::{HarmonicsOverride, Overrides};
