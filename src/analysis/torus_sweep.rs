@@ -11,6 +11,10 @@ use crate::torus::{
     NewtonKrylov, TorusBalance, TorusSolution, TorusStability, TorusSweep, Truncation,
 };
 
+/// Sweeps run again with raised automatic caps where a point's estimate is above the
+/// tolerance.
+const EXTRA_PASSES: usize = 3;
+
 /// Order cuts kept per element coordinate.
 pub const CUTS_PER_ELEMENT: usize = 8;
 
@@ -77,6 +81,9 @@ pub struct TorusSweepAnalysis {
     pub order_cuts: Vec<OrderCut>,
     /// The stability statement.
     pub stability: TorusStability,
+    /// With automatic caps: why a point's estimate stays above the tolerance (`None`: every
+    /// converged point is within it, or fixed caps).
+    pub caps_stopped: Option<String>,
     /// Every point's solution (not in the JSON).
     #[serde(skip)]
     pub solutions: Vec<TorusSolution>,
@@ -88,9 +95,9 @@ impl TorusSweepAnalysis {
         self.points.iter().filter(|p| !p.converged).count() + self.skipped.len()
     }
 
-    /// 0 if every point converged, else 1.
+    /// 0 if every point converged (and automatic caps reached their tolerance), else 1.
     pub fn exit_code(&self) -> u8 {
-        u8::from(self.failures() > 0)
+        u8::from(self.failures() > 0 || self.caps_stopped.is_some())
     }
 }
 
@@ -136,35 +143,82 @@ pub fn torus_sweep(
         tolerance: plan.tolerance,
         ..NewtonKrylov::default()
     };
-    // Automatic caps: the largest the ends of the range need, for the whole sweep.
-    let (mut caps, mut samples) = (plan.caps.clone(), plan.samples.clone());
-    let mut truncation = plan.truncation;
+    // Automatic caps: the largest the ends of the range need, for the whole sweep; then, where
+    // a point of that sweep still has an estimate above the tolerance, the caps that point
+    // needs and the sweep once more.
+    let mut grid = Grid {
+        caps: plan.caps.clone(),
+        samples: plan.samples.clone(),
+        truncation: plan.truncation,
+    };
     if let Some(auto) = &plan.auto {
         observer.stage("choosing the caps at both ends");
         for w in [speeds[0], speeds[n - 1]] {
-            let o = auto.solve(&tm, &plan.caps, &plan.samples, plan.truncation, w, &solver)?;
-            for b in 0..caps.len() {
-                caps[b] = caps[b].max(o.caps[b]);
-                samples[b] = samples[b].max(o.samples[b]);
-            }
-            // A diamond's total grows with the caps: the larger of the two ends.
-            if let (Truncation::Diamond { total: a }, Truncation::Diamond { total: b }) =
-                (truncation, o.truncation)
-            {
-                truncation = Truncation::Diamond { total: a.max(b) };
-            }
+            grid.raise(&auto.solve(&tm, &plan.caps, &plan.samples, plan.truncation, w, &solver)?);
         }
     }
-    let set = crate::torus::IndexSet::new(&plan.bases, &caps, truncation)?;
-    let mut hb = TorusBalance::new(tm, set, &samples, speeds[0])?;
-    observer.stage("sweeping");
-    let result = TorusSweep {
+    let sweep = TorusSweep {
         solver,
         ..Default::default()
-    }
-    .run(&mut hb, &speeds, |i, _| {
+    };
+    let mut hb = TorusBalance::new(tm.clone(), grid.set(plan)?, &grid.samples, speeds[0])?;
+    observer.stage("sweeping");
+    let mut result = sweep.run(&mut hb, &speeds, |i, _| {
         observer.progress((i + 1) as f64 / n as f64)
     })?;
+    let mut caps_stopped = None;
+    if let Some(auto) = &plan.auto {
+        for pass in 0..=EXTRA_PASSES {
+            let worst = result
+                .points
+                .iter()
+                .filter(|p| p.converged)
+                .map(|p| {
+                    (
+                        p.truncation
+                            .iter()
+                            .flatten()
+                            .fold(0.0, |a: f64, &e| a.max(e)),
+                        p.omega,
+                    )
+                })
+                .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+            if worst.0 <= auto.tolerance {
+                break;
+            }
+            let before = grid.caps.clone();
+            if pass < EXTRA_PASSES {
+                observer.stage("raising the caps where the sweep needs more");
+                let o = auto.solve(
+                    &tm,
+                    &grid.caps,
+                    &grid.samples,
+                    grid.truncation,
+                    worst.1,
+                    &solver,
+                )?;
+                grid.raise(&o);
+            }
+            if grid.caps == before {
+                caps_stopped = Some(format!(
+                    "a truncation estimate of {:.1e} at {} {} is above the tolerance {:.0e} with the caps {:?} (automatic caps: {})",
+                    worst.0,
+                    crate::report::significant(worst.1 / per, 6),
+                    scene.speed_unit,
+                    auto.tolerance,
+                    grid.caps,
+                    if pass < EXTRA_PASSES { "they stop there" } else { "passes used up" }
+                ));
+                break;
+            }
+            hb = TorusBalance::new(tm.clone(), grid.set(plan)?, &grid.samples, speeds[0])?;
+            observer.stage("sweeping again");
+            result = sweep.run(&mut hb, &speeds, |i, _| {
+                observer.progress((i + 1) as f64 / n as f64)
+            })?;
+        }
+    }
+    let (caps, samples) = (grid.caps, grid.samples);
     let sol_points: Vec<TorusPointRecord> = result
         .points
         .iter()
@@ -207,6 +261,7 @@ pub fn torus_sweep(
             .map(|(w, m)| (w / per, m.clone()))
             .collect(),
         stability: result.stability,
+        caps_stopped,
         solutions: result.points,
     })
 }
@@ -255,4 +310,30 @@ fn order_cuts(scene: &Scene, points: &[TorusSolution], per: f64) -> Vec<OrderCut
         }
     }
     cuts
+}
+
+/// The caps, grid and truncation a sweep runs on.
+struct Grid {
+    caps: Vec<usize>,
+    samples: Vec<usize>,
+    truncation: Truncation,
+}
+
+impl Grid {
+    /// At least what the automatic caps `o` reached (a diamond's total too).
+    fn raise(&mut self, o: &crate::torus::AutoCapsOutcome) {
+        for b in 0..self.caps.len() {
+            self.caps[b] = self.caps[b].max(o.caps[b]);
+            self.samples[b] = self.samples[b].max(o.samples[b]);
+        }
+        if let (Truncation::Diamond { total: a }, Truncation::Diamond { total: b }) =
+            (self.truncation, o.truncation)
+        {
+            self.truncation = Truncation::Diamond { total: a.max(b) };
+        }
+    }
+
+    fn set(&self, plan: &crate::scene::TorusPlan) -> Result<crate::torus::IndexSet> {
+        crate::torus::IndexSet::new(&plan.bases, &self.caps, self.truncation)
+    }
 }

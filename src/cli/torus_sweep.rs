@@ -40,6 +40,9 @@ pub(crate) fn sweep(scene: &Scene, opts: TorusSweepOptions) -> Result<u8, Failur
             );
         }
     }
+    if let Some(why) = &a.caps_stopped {
+        eprintln!("error: {}: automatic caps: {why}", scene.file);
+    }
     if a.failures() > 0 {
         eprintln!(
             "error: {}: {} of {} points did not converge or could not be set up (marked in points.csv and the JSON)",

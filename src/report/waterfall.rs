@@ -163,7 +163,10 @@ pub fn waterfall_plot(
         .highlight
         .iter()
         .enumerate()
-        .map(|(i, o)| super::Series::line(format!("order {o}"), Vec::new()).with_color(i))
+        .map(|(i, o)| {
+            super::Series::line(format!("order {}", super::significant(*o, 6)), Vec::new())
+                .with_color(i)
+        })
         .collect();
     let labelled: Vec<(usize, &super::Series)> = legend.iter().enumerate().collect();
     super::plot::draw_legend(&legend_area, &legend, &labelled)?;
