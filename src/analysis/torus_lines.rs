@@ -2,7 +2,6 @@
 //! `k·r` of the speed, labelled by its combination of bases (`stage1 − 2 engine`), per DOF
 //! and per element coordinate (a gear stage's transmission error).
 
-use crate::model::Model;
 use crate::torus::TorusSolution;
 use num_complex::Complex64;
 
@@ -75,31 +74,13 @@ pub fn line_label(names: &[String], k: &[i32]) -> String {
     out
 }
 
-/// The lines `Σ w_i Q_{i,k}` of the coordinate with weights `weights` (`(dof, w)`), line by
-/// line.
-pub(crate) fn coordinate_lines(sol: &TorusSolution, weights: &[(usize, f64)]) -> Vec<Complex64> {
-    let n = sol.n_dofs();
-    (0..sol.indices.len())
-        .map(|j| {
-            weights.iter().fold(Complex64::default(), |acc, &(i, w)| {
-                let (re, im) = sol.harmonics[j * n + i];
-                acc + Complex64::new(re, im) * w
-            })
-        })
-        .collect()
-}
-
 /// The spectrum called `name` of the lines `q` (line-major over the solution's index set),
 /// keeping the `top` strongest; `speed_hz` is the speed Ω/2π.
 pub(crate) fn spectrum(sol: &TorusSolution, name: &str, q: &[Complex64], top: usize) -> Spectrum {
     let hz = sol.omega / std::f64::consts::TAU;
     let mut lines: Vec<LineRecord> = (1..q.len())
         .map(|j| {
-            let order: f64 = sol.indices[j]
-                .iter()
-                .zip(&sol.ratios)
-                .map(|(&k, r)| k as f64 * r)
-                .sum();
+            let order = sol.order(j);
             LineRecord {
                 k: sol.indices[j].clone(),
                 label: line_label(&sol.bases, &sol.indices[j]),
@@ -121,18 +102,9 @@ pub(crate) fn spectrum(sol: &TorusSolution, name: &str, q: &[Complex64], top: us
     }
 }
 
-/// The spectra of every element coordinate of `model` (gear stages: the transmission error).
-pub(crate) fn element_spectra(model: &Model, sol: &TorusSolution, top: usize) -> Vec<Spectrum> {
-    model
-        .elements()
-        .iter()
-        .map(|e| spectrum(sol, e.name(), &coordinate_lines(sol, e.weights()), top))
-        .collect()
-}
-
 /// The spectra of every DOF.
 pub(crate) fn dof_spectra(sol: &TorusSolution, top: usize) -> Vec<Spectrum> {
     (0..sol.n_dofs())
-        .map(|i| spectrum(sol, &sol.dofs[i], &coordinate_lines(sol, &[(i, 1.0)]), top))
+        .map(|i| spectrum(sol, &sol.dofs[i], &sol.coordinate_lines(&[(i, 1.0)]), top))
         .collect()
 }

@@ -2,7 +2,7 @@
 //! (with automatic caps where the scene asks), each base's truncation estimate, the spectra
 //! of every element coordinate and DOF as labelled lines, and the stability statement.
 
-use super::torus_lines::{coordinate_lines, dof_spectra, element_spectra, spectrum, Spectrum};
+use super::torus_lines::{dof_spectra, spectrum, Spectrum};
 use crate::error::{Error, Result};
 use crate::scene::{Scene, TorusPlan};
 use crate::torus::{
@@ -171,6 +171,12 @@ fn analysis_of(
         .zip(&forces)
         .map(|(name, f)| spectrum(&sol, name, f, TOP_LINES))
         .collect();
+    let element_lines: Vec<(String, Vec<Complex64>)> = scene
+        .model
+        .elements()
+        .iter()
+        .map(|e| (e.name().to_string(), sol.coordinate_lines(e.weights())))
+        .collect();
     let force_lines = scene
         .model
         .elements()
@@ -198,15 +204,13 @@ fn analysis_of(
         relative_residual: sol.relative_residual,
         levels: outcome.levels,
         caps_stopped: outcome.stopped,
-        elements: element_spectra(&scene.model, &sol, TOP_LINES),
+        elements: element_lines
+            .iter()
+            .map(|(name, q)| spectrum(&sol, name, q, TOP_LINES))
+            .collect(),
         forces: force_spectra,
         force_lines,
-        element_lines: scene
-            .model
-            .elements()
-            .iter()
-            .map(|e| (e.name().to_string(), coordinate_lines(&sol, e.weights())))
-            .collect(),
+        element_lines,
         dofs: dof_spectra(&sol, TOP_LINES),
         stability: TorusStability::quasi_periodic(),
         solution: sol,

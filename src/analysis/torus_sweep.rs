@@ -2,7 +2,7 @@
 //! speed ([`crate::torus::TorusSweep`], natural continuation), with each point's convergence
 //! and truncation estimates and the order cuts of every element coordinate's strongest lines.
 
-use super::torus_lines::{coordinate_lines, line_label};
+use super::torus_lines::line_label;
 use super::torus_solve::{plan_of, BaseRecord};
 use super::Observer;
 use crate::error::{Error, Result};
@@ -277,7 +277,7 @@ fn order_cuts(scene: &Scene, points: &[TorusSolution], per: f64) -> Vec<OrderCut
         let lines: Vec<Vec<f64>> = points
             .iter()
             .map(|p| {
-                coordinate_lines(p, e.weights())
+                p.coordinate_lines(e.weights())
                     .iter()
                     .map(|q| q.norm())
                     .collect()
@@ -298,11 +298,7 @@ fn order_cuts(scene: &Scene, points: &[TorusSolution], per: f64) -> Vec<OrderCut
             cuts.push(OrderCut {
                 element: e.name().to_string(),
                 label: line_label(&first.bases, &k),
-                order: k
-                    .iter()
-                    .zip(&first.ratios)
-                    .map(|(&k, r)| k as f64 * r)
-                    .sum(),
+                order: first.order(j),
                 k,
                 amplitudes: lines.iter().map(|l| l[j]).collect(),
                 peak: peak(j),

@@ -169,8 +169,8 @@ fn write_lines(path: &Path, a: &TorusSolveAnalysis) -> anyhow::Result<()> {
     w.write_record(&header)?;
     let sol = &a.solution;
     for (what, name, q) in quantities(a) {
-        for (k, q) in sol.indices.iter().zip(&q) {
-            let order: f64 = k.iter().zip(&sol.ratios).map(|(&k, r)| k as f64 * r).sum();
+        for (j, (k, q)) in sol.indices.iter().zip(&q).enumerate() {
+            let order = sol.order(j);
             let mut row = vec![
                 what.to_string(),
                 name.clone(),
@@ -226,15 +226,7 @@ fn plot_spectrum(path: &Path, scene: &Scene, a: &TorusSolveAnalysis) {
         .iter()
         .map(|(name, q)| {
             let mut points: Vec<(f64, f64)> = (1..q.len())
-                .map(|j| {
-                    let k = &a.solution.indices[j];
-                    let order: f64 = k
-                        .iter()
-                        .zip(&a.solution.ratios)
-                        .map(|(&k, r)| k as f64 * r)
-                        .sum();
-                    (order, q[j].norm())
-                })
+                .map(|j| (a.solution.order(j), q[j].norm()))
                 .filter(|p| p.1 > 0.0)
                 .collect();
             points.sort_by(|x, y| x.0.total_cmp(&y.0));

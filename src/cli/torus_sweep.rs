@@ -247,32 +247,14 @@ fn waterfall(
     let Some(e) = scene.model.elements().iter().find(|e| e.name() == name) else {
         return;
     };
-    let order = |s: &hbal::torus::TorusSolution, j: usize| -> f64 {
-        s.indices[j]
-            .iter()
-            .zip(&s.ratios)
-            .map(|(&k, r)| k as f64 * r)
-            .sum()
-    };
     let slices: Vec<Slice> = a
         .solutions
         .iter()
         .map(|s| {
-            let n = s.n_dofs();
+            let q = s.coordinate_lines(e.weights());
             Slice {
                 speed: s.omega / scene.torus.as_ref().map_or(1.0, |p| p.rad_s_per_speed),
-                amplitudes: (1..s.indices.len())
-                    .map(|j| {
-                        let q = e.weights().iter().fold(
-                            hbal::num_complex::Complex64::default(),
-                            |acc, &(i, w)| {
-                                let (re, im) = s.harmonics[j * n + i];
-                                acc + hbal::num_complex::Complex64::new(re, im) * w
-                            },
-                        );
-                        (order(s, j), q.norm())
-                    })
-                    .collect(),
+                amplitudes: (1..q.len()).map(|j| (s.order(j), q[j].norm())).collect(),
             }
         })
         .collect();
@@ -282,7 +264,7 @@ fn waterfall(
         .map(|s| {
             (1..s.indices.len())
                 .filter(|&j| s.indices[j].iter().filter(|&&k| k != 0).count() == 1)
-                .map(|j| order(s, j))
+                .map(|j| s.order(j))
                 .collect()
         })
         .unwrap_or_default();

@@ -17,23 +17,16 @@ impl TorusBalance<'_> {
             .iter()
             .map(|&(a, b)| Complex64::new(a, b))
             .collect();
-        let n = sol.n_dofs();
-        let lines = self.set.len();
         let model = self.torus_model().model();
         let mut out: Vec<Vec<Complex64>> = model
             .elements()
             .iter()
             .map(|e| {
                 let lin = e.linear_part();
-                (0..lines)
-                    .map(|j| {
-                        let q = e
-                            .weights()
-                            .iter()
-                            .fold(Complex64::default(), |acc, &(i, w)| {
-                                let (re, im) = sol.harmonics[j * n + i];
-                                acc + Complex64::new(re, im) * w
-                            });
+                sol.coordinate_lines(e.weights())
+                    .into_iter()
+                    .enumerate()
+                    .map(|(j, q)| {
                         let nu = self.frequency(j);
                         let offset = if j == 0 { lin.offset } else { 0.0 };
                         q * Complex64::new(lin.stiffness, nu * lin.damping) + offset

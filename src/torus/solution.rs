@@ -82,6 +82,29 @@ impl TorusSolution {
             .sum()
     }
 
+    /// The order `k·r` of the speed of line `j`.
+    pub fn order(&self, j: usize) -> f64 {
+        self.indices[j]
+            .iter()
+            .zip(&self.ratios)
+            .map(|(&k, r)| k as f64 * r)
+            .sum()
+    }
+
+    /// The lines `Σ w_i Q_{i,k}` of the coordinate with weights `(dof, w)`, line by line (a
+    /// gear stage's transmission error with the element's weights).
+    pub fn coordinate_lines(&self, weights: &[(usize, f64)]) -> Vec<Complex64> {
+        let n = self.n_dofs();
+        (0..self.indices.len())
+            .map(|j| {
+                weights.iter().fold(Complex64::default(), |acc, &(i, w)| {
+                    let (re, im) = self.harmonics[j * n + i];
+                    acc + Complex64::new(re, im) * w
+                })
+            })
+            .collect()
+    }
+
     /// The lines of DOF `dof` as `(k, ν_k, |Q_k|)`, strongest first (the mean excluded).
     pub fn lines(&self, dof: usize) -> Vec<(Vec<i32>, f64, f64)> {
         let n = self.n_dofs();
