@@ -94,12 +94,13 @@ impl MeshProfile {
             }
             MeshProfile::Cosine { mean, amplitude } => mean + amplitude * phi.cos(),
             MeshProfile::Fourier { mean, cos, sin } => {
+                // e^{i (j+1) φ} by rotation: one sine and cosine however many orders.
+                let (s1, c1) = phi.sin_cos();
+                let (mut re, mut im) = (c1, s1);
                 let mut k = *mean;
-                for (j, c) in cos.iter().enumerate() {
-                    k += c * ((j + 1) as f64 * phi).cos();
-                }
-                for (j, s) in sin.iter().enumerate() {
-                    k += s * ((j + 1) as f64 * phi).sin();
+                for j in 0..cos.len().max(sin.len()) {
+                    k += cos.get(j).map_or(0.0, |c| c * re) + sin.get(j).map_or(0.0, |s| s * im);
+                    (re, im) = (re * c1 - im * s1, re * s1 + im * c1);
                 }
                 k
             }

@@ -38,6 +38,7 @@ pub struct TorusBalance<'m> {
     pub(super) w: DMatrix<f64>,
     f_full: Vec<Complex64>,
     pub(super) linear: TorusLinear,
+    pub(super) line_plans: super::edges::LinePlans,
 }
 
 /// Buffers of [`TorusBalance`]; make one with [`TorusBalance::workspace`].
@@ -58,6 +59,8 @@ pub struct TorusWorkspace {
     pub(super) gdu: Vec<Vec<f64>>,
     /// One grid line along a base: `u`, `u̇` and the law's values there.
     pub(super) lines: [Vec<f64>; 4],
+    /// The contact edges' correction.
+    pub(super) edges: super::edges::EdgeBuffers,
     /// One line's m coordinates (the receptance form's `G_j x_j`).
     line: Vec<Complex64>,
     /// Transforms done.
@@ -93,6 +96,7 @@ impl<'m> TorusBalance<'m> {
             .iter()
             .map(|&nb| (0..nb).map(|j| TAU * j as f64 / nb as f64).collect())
             .collect();
+        let line_plans = super::edges::LinePlans::new(fft.dims());
         let dense = model.dense("torus harmonic balance")?;
         let w = DMatrix::from_fn(n, coordinates.len(), |i, c| {
             coordinates[c]
@@ -130,6 +134,7 @@ impl<'m> TorusBalance<'m> {
             w,
             f_full,
             linear,
+            line_plans,
         })
     }
 
@@ -171,6 +176,7 @@ impl<'m> TorusBalance<'m> {
                 vec![0.0; self.fft.dims().iter().copied().max().unwrap_or(0)]
             }),
             line: vec![Complex64::default(); m],
+            edges: self.line_plans.buffers(m),
             ffts: 0,
         }
     }

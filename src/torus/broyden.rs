@@ -20,6 +20,10 @@ use num_complex::Complex64;
 /// Consecutive uphill steps before the run ends.
 const MAX_RESTARTS: usize = 3;
 
+/// Steps in a row with a residual 100 times its best before a run is taken as lost (it
+/// wandered off; a run that comes back does so well within this).
+const MAX_LOST: usize = 60;
+
 /// Broyden settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TorusBroyden {
@@ -73,7 +77,8 @@ impl TorusBroyden {
     /// Solves `hb` from `start` (the linear response where `None`). A step that does not
     /// lower the residual after 12 halvings is taken in full (uphill: its secant pair carries
     /// what the averaged Jacobian misses where a contact opens); the fourth such step in a
-    /// row ends the run at the best iterate, marked not converged.
+    /// row ends the run at the best iterate, marked not converged, as do 60 steps in a row
+    /// whose residual is 100 times the best (a run that wandered off).
     pub fn solve(&self, hb: &TorusBalance, start: Option<&[Complex64]>) -> Result<TorusSolution> {
         let mut ws = hb.workspace();
         let mut u = start_of(hb, start)?;
@@ -91,6 +96,7 @@ impl TorusBroyden {
             let mut failures = 0;
             // The best iterate, which a run that stops after uphill steps returns.
             let mut best = (norm(&r), u.clone());
+            let (mut best_relative, mut lost) = (f64::INFINITY, 0);
             loop {
                 relative = relative_residual(hb, &u, &r);
                 if relative <= self.tolerance {
@@ -100,7 +106,14 @@ impl TorusBroyden {
                 if norm(&r) < best.0 {
                     best = (norm(&r), u.clone());
                 }
-                if iterations >= self.max_iterations || failures > MAX_RESTARTS {
+                best_relative = best_relative.min(relative);
+                lost = if relative > 100.0 * best_relative {
+                    lost + 1
+                } else {
+                    0
+                };
+                if iterations >= self.max_iterations || failures > MAX_RESTARTS || lost >= MAX_LOST
+                {
                     if norm(&r) > best.0 {
                         u = best.1;
                         hb.residual_into(&u, &mut r, false, &mut ws)?;
@@ -112,18 +125,21 @@ impl TorusBroyden {
                 let mut step: Vec<Complex64> = r.iter().map(|v| -v).collect();
                 h.apply(&mut step);
                 let (u_old, r_old) = (u.clone(), r.clone());
-                if !line_search(hb, &mut u, &mut r, &step, &mut ws)? {
+                if !line_search(hb, &mut u, &mut r, &step, (false, 12), &mut ws)? {
                     failures += 1;
                     // A full step uphill (non-monotone): the secant pair it gives carries
                     // what the averaged Jacobian misses where a contact opens.
                     for (x, s) in u.iter_mut().zip(&step) {
                         *x += s;
                     }
-                    hb.residual_into(&u, &mut r, true, &mut ws)?;
+                    hb.residual_into(&u, &mut r, false, &mut ws)?;
                 } else {
                     failures = 0;
                 }
                 if h.pairs.len() >= self.memory {
+                    // The averaged Jacobian at the current state (the line search evaluates
+                    // forces only).
+                    hb.residual_into(&u, &mut r, true, &mut ws)?;
                     h = fresh(&ws);
                     continue;
                 }

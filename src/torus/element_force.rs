@@ -44,6 +44,7 @@ impl TorusBalance<'_> {
             self.synthesize(&u, c, false, &mut x, &mut ws.fft);
             self.synthesize(&u, c, true, &mut dx, &mut ws.fft);
             (ws.u[c], ws.du[c]) = (x, dx);
+            self.note_reach(&u, c, &mut ws);
             self.law_samples(act, &mut ws);
             let mut f = std::mem::take(&mut ws.fe);
             let target = &mut out[act.index];

@@ -21,6 +21,8 @@ pub(super) struct TorusElement {
     pub(super) band_limited: Option<Arc<dyn ForceLaw>>,
     /// Grid points whose angle of the element's base sits on a time jump of the law.
     pub(super) jumps: Vec<usize>,
+    /// The law's contact edges in u ([`ForceLaw::kinks`]), corrected along the base's lines.
+    pub(super) kinks: Vec<f64>,
     pub(super) linear: LinearPart,
 }
 
@@ -132,6 +134,7 @@ pub(super) fn active_elements(
         } else {
             Vec::new()
         };
+        let kinks = law.kinks().into_iter().filter(|k| k.is_finite()).collect();
         active.push(TorusElement {
             index,
             coordinate,
@@ -139,6 +142,7 @@ pub(super) fn active_elements(
             base,
             band_limited,
             jumps,
+            kinks,
             linear: e.linear_part(),
         });
     }

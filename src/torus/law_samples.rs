@@ -1,5 +1,6 @@
 //! The laws on the torus grid: every element's force (and its derivatives) at the grid's
-//! samples of its coordinate, evaluated line by line along its own base's axis.
+//! samples of its coordinate, evaluated line by line along its own base's axis and corrected
+//! where a contact edge is crossed between samples ([`super::edges`]).
 
 use super::elements::TorusElement;
 use super::{TorusBalance, TorusWorkspace};
@@ -18,6 +19,7 @@ impl TorusBalance<'_> {
         for c in 0..self.coordinates() {
             self.synthesize(u, c, false, &mut ws.u[c], &mut ws.fft);
             self.synthesize(u, c, true, &mut ws.du[c], &mut ws.fft);
+            self.note_reach(u, c, ws);
             ws.ffts += 2;
             ws.force[c].fill(0.0);
             if derivatives {
@@ -67,6 +69,7 @@ impl TorusBalance<'_> {
                 let (a1, b1) = law.derivatives(t + delta, x, v);
                 (ws.ge[p], ws.gde[p]) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
             }
+            self.correct_edge_derivatives(act, ws);
             let s2 = s * s;
             for p in 0..ws.ge.len() {
                 let (a, b) = (ws.ge[p] - lin.stiffness, ws.gde[p] - lin.damping);
@@ -105,6 +108,7 @@ impl TorusBalance<'_> {
             let (t, x, v) = (line[(p / stride) % n], ws.ue[p], ws.due[p]);
             ws.fe[p] = 0.5 * (law.force(t - delta, x, v) + law.force(t + delta, x, v));
         }
+        self.correct_edge_forces(act, law, ws);
     }
 
     /// The law's force at every grid point into `ws.fe` (or its derivatives into `ws.ge`,

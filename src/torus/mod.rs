@@ -18,8 +18,11 @@
 //! every mesh phasing at once. d = 1 is the one-frequency basis of [`crate::HarmonicBasis`],
 //! which the rest of hbal uses.
 //!
-//! The AFT samples contact edges plainly (no kink correction as in the one-frequency engine),
-//! so a backlash that opens converges at the rate of the grid.
+//! Where a contact edge is crossed between grid points, the AFT corrects its trapezoid sums
+//! along each grid line of the element's own base, as the one-frequency engine does on its
+//! period ([`crate::harmonic::kinks`]): the line's coordinate is a trigonometric polynomial
+//! of that base's angle, whose crossings of the edge are found by Newton and whose
+//! Euler–Maclaurin error is subtracted, written back as band-limited samples.
 //!
 //! ```
 //! use hbal::{force::CubicSpring, torus::*, Model};
@@ -46,6 +49,7 @@ mod auto_caps;
 mod balance;
 mod bases;
 mod broyden;
+mod edges;
 mod element_force;
 mod elements;
 mod estimate;

@@ -81,7 +81,7 @@ impl NewtonKrylov {
                 .max(0.5 * self.tolerance / relative)
                 .min(0.5);
                 linear += self.direction(hb, &r, eta, &mut step, &mut ws);
-                if !line_search(hb, &mut u, &mut r, &step, &mut ws)? {
+                if !line_search(hb, &mut u, &mut r, &step, (true, 12), &mut ws)? {
                     break;
                 }
             }
@@ -137,25 +137,26 @@ pub(super) fn relative_residual(hb: &TorusBalance, u: &[Complex64], r: &[Complex
     norm(r) / norm(hb.load()).max(norm(&lin)).max(f64::MIN_POSITIVE)
 }
 
-/// Backtracking along `step` from `u` (Armijo on ‖R‖ with a small slope, 12 halvings): moves
-/// `u` and its residual `r` (with the Jacobian's samples) on success; `false` (and `u`, `r`
-/// as they were) where no step lowers ‖R‖.
+/// Backtracking along `step` from `u` (Armijo on ‖R‖ with a small slope, `halvings`): moves
+/// `u` and its residual `r` (with the Jacobian's samples where `derivatives`) on success;
+/// `false` (and `u`, `r` as they were) where no step lowers ‖R‖.
 pub(super) fn line_search(
     hb: &TorusBalance,
     u: &mut Vec<Complex64>,
     r: &mut Vec<Complex64>,
     step: &[Complex64],
+    (derivatives, halvings): (bool, usize),
     ws: &mut TorusWorkspace,
 ) -> Result<bool> {
     let r_norm = norm(r);
     let mut trial = vec![Complex64::default(); u.len()];
     let mut r_trial = vec![Complex64::default(); u.len()];
     let mut alpha = 1.0;
-    for _ in 0..12 {
+    for _ in 0..halvings {
         for ((t, x), s) in trial.iter_mut().zip(u.iter()).zip(step) {
             *t = x + s * alpha;
         }
-        hb.residual_into(&trial, &mut r_trial, true, ws)?;
+        hb.residual_into(&trial, &mut r_trial, derivatives, ws)?;
         if norm(&r_trial) <= (1.0 - 1e-4 * alpha) * r_norm {
             *u = trial;
             *r = r_trial;
@@ -163,7 +164,7 @@ pub(super) fn line_search(
         }
         alpha *= 0.5;
     }
-    hb.residual_into(u, r, true, ws)?;
+    hb.residual_into(u, r, derivatives, ws)?;
     Ok(false)
 }
 

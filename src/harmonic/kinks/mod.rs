@@ -214,21 +214,6 @@ pub(crate) fn derivatives(uk: &[Complex64], theta: f64) -> [f64; 4] {
     out
 }
 
-/// Where the element coordinate crosses a kink: the kink `κ`, the angle `θ*` (on the
-/// fundamental, in `[0, 2π)` up to rounding), the sample interval `j` with
-/// `θ_j <= θ* <= θ_{j+1}` and the slope `u'(θ*)` (per radian of θ).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EdgeCrossing {
-    /// The kink `κ` crossed.
-    pub kappa: f64,
-    /// `θ*`.
-    pub theta: f64,
-    /// The sample interval `j`.
-    pub sample: usize,
-    /// `u'(θ*)`.
-    pub slope: f64,
-}
-
 /// The crossings of the kinks `kinks` by the element coordinate with samples `u` and `du`
 /// (its time derivative) at `θ_j = 2π j / N` and harmonics `uk`, with the jumps of the force
 /// of `law` there, appended to `out` (allocates; the AFT calls [`find_edge_crossings`] and
@@ -265,7 +250,14 @@ pub fn crossing_jumps(
     for e in edges {
         let d = derivatives(uk, e.theta);
         let alpha = ((e.theta - e.sample as f64 * h) / h).clamp(0.0, 1.0);
-        let c = jumps(law, e.kappa, e.theta, alpha, d, fundamental, nu, h);
+        let orbit = OrbitAt {
+            theta: e.theta,
+            alpha,
+            u: d,
+            v: [fundamental * d[1], fundamental * d[2], fundamental * d[3]],
+        };
+        let shaft = |t: f64| (nu as f64 * t).rem_euclid(TAU);
+        let c = jumps(law, e.kappa, &orbit, shaft, h);
         let finite = c
             .jumps
             .iter()
@@ -278,189 +270,12 @@ pub fn crossing_jumps(
     }
 }
 
-/// The crossings of the kinks `kinks` by the element coordinate with samples `u` and `du`
-/// (its time derivative) at `θ_j = 2π j / N` and harmonics `uk`, appended to `out`.
-/// `fundamental` is the Ω/ν that turns θ-derivatives into time derivatives.
-///
-/// A crossing shows as a change of side between two samples; two crossings inside one sample
-/// interval (the coordinate grazes the edge and comes back) show as an extremum there (`du`
-/// changes sign) beyond the edge, and are found as well, so the residual stays continuous when
-/// a contact opens or closes between samples.
-pub fn find_edge_crossings(
-    kinks: &[f64],
-    u: &[f64],
-    du: &[f64],
-    uk: &[Complex64],
-    fundamental: f64,
-    out: &mut Vec<EdgeCrossing>,
-) {
-    let n = u.len();
-    let h = TAU / n as f64;
-    let mut push = |kappa: f64, theta: f64, sample: usize| {
-        let slope = derivatives(uk, theta)[1];
-        out.push(EdgeCrossing {
-            kappa,
-            theta,
-            sample,
-            slope,
-        });
-    };
-    // Between samples `u` moves at most `h max |u_θ| ≤ h Σ k |u_k|`: a kink outside the
-    // samples' range by more is neither crossed nor grazed.
-    let (lowest, highest) = u
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, m), &x| {
-            (l.min(x), m.max(x))
-        });
-    let reach = h * uk
-        .iter()
-        .enumerate()
-        .map(|(k, c)| k as f64 * c.norm())
-        .sum::<f64>();
-    for &kappa in kinks {
-        if kappa < lowest - reach || kappa > highest + reach {
-            continue;
-        }
-        // The scan is most of the cost where nothing is crossed: no division (modulo) and no
-        // conversion per sample.
-        let (mut b, mut vb) = (u[0] - kappa, du[0]);
-        for j in 0..n {
-            let next = if j + 1 == n { 0 } else { j + 1 };
-            // Sides as the laws draw them: `u > κ` above, `u = κ` below (a sample on the edge
-            // belongs to the side below, so the crossing is still seen).
-            let (a, va) = (b, vb);
-            (b, vb) = (u[next] - kappa, du[next]);
-            if (a > 0.0) != (b > 0.0) {
-                let (lo, hi) = (j as f64 * h, (j + 1) as f64 * h);
-                let t = root(uk, kappa, lo, hi, a > 0.0, lo + h * a / (a - b));
-                push(kappa, t, j);
-                continue;
-            }
-            if va * vb >= 0.0 {
-                continue;
-            }
-            let (lo, hi) = (j as f64 * h, (j + 1) as f64 * h);
-            // An extremum inside: can it reach the edge? (|u - u_j| <= max |u'| h.)
-            if a.abs().min(b.abs()) > (va.abs() + vb.abs()) / fundamental * h {
-                continue;
-            }
-            let te = extremum(uk, lo, hi, va > 0.0);
-            let e = derivatives(uk, te)[0] - kappa;
-            if (e > 0.0) != (a > 0.0) {
-                let t1 = root(uk, kappa, lo, te, a > 0.0, 0.5 * (lo + te));
-                let t2 = root(uk, kappa, te, hi, e > 0.0, 0.5 * (te + hi));
-                push(kappa, t1, j);
-                push(kappa, t2, j);
-            }
-        }
-    }
-}
-
-/// The root of `u(θ) = κ` in `[lo, hi]` (the side at `lo` is `lo_above`), from `t`.
-fn root(uk: &[Complex64], kappa: f64, lo: f64, hi: f64, lo_above: bool, t: f64) -> f64 {
-    let tol = 1e-14 * (1.0 + kappa.abs());
-    bracketed_newton(lo, hi, t, lo_above, tol, |t| {
-        let d = derivatives(uk, t);
-        (d[0] - kappa, d[1])
-    })
-}
-
-/// The extremum of `u` in `[lo, hi]`, where `u'` changes sign (positive at `lo` if
-/// `rising`).
-fn extremum(uk: &[Complex64], lo: f64, hi: f64, rising: bool) -> f64 {
-    bracketed_newton(lo, hi, 0.5 * (lo + hi), rising, 0.0, |t| {
-        let d = derivatives(uk, t);
-        (d[1], d[2])
-    })
-}
-
-/// The zero of `g` in `[lo, hi]` (`g > 0` at `lo` if `lo_positive`), by Newton from `t` with
-/// `f(t) = (g, g')`, kept inside the shrinking bracket (bisection where a step leaves it);
-/// stops at `|g| <= tol` or a step of 1e-15 of a period.
-pub(crate) fn bracketed_newton(
-    mut lo: f64,
-    mut hi: f64,
-    t: f64,
-    lo_positive: bool,
-    tol: f64,
-    f: impl Fn(f64) -> (f64, f64),
-) -> f64 {
-    let mut t = t.clamp(lo, hi);
-    for _ in 0..60 {
-        let (g, slope) = f(t);
-        if g.abs() <= tol {
-            break;
-        }
-        if (g > 0.0) == lo_positive {
-            lo = t;
-        } else {
-            hi = t;
-        }
-        let next = t - g / slope;
-        let next = if next >= lo && next <= hi && next.is_finite() {
-            next
-        } else {
-            0.5 * (lo + hi)
-        };
-        let moved = (next - t).abs();
-        t = next;
-        if moved <= 1e-15 * TAU {
-            break;
-        }
-    }
-    t
-}
-
-/// `[f]`, `[f']`, `[f'']` in θ along the orbit at its crossing of `kappa` at θ, where
-/// `d = (u, u', u'', u''')` (module documentation).
-#[allow(clippy::too_many_arguments)]
-fn jumps(
-    law: &dyn ForceLaw,
-    kappa: f64,
-    theta: f64,
-    alpha: f64,
-    d: [f64; 4],
-    w: f64,
-    nu: usize,
-    h: f64,
-) -> Crossing {
-    // One-sided values at κ ± δ, δ a millionth of the coordinate's change over a sample (so
-    // the result does not depend on the units of u); the O(δ) slope is taken out below.
-    let delta = match 1e-6 * d[1].abs() * h {
-        x if x > 0.0 => x,
-        _ => 1e-12 * (1.0 + kappa.abs()),
-    };
-    let v = w * d[1];
-    let (v1, v2) = (w * d[2], w * d[3]);
-    let shaft = |t: f64| (nu as f64 * t).rem_euclid(TAU);
-    // D, D_u, D_v at basis angle t.
-    let diff = |t: f64| {
-        let p = shaft(t);
-        let (ku, kv) = law.derivatives(p, kappa + delta, v);
-        let (lu, lv) = law.derivatives(p, kappa - delta, v);
-        let d0 =
-            law.force(p, kappa + delta, v) - law.force(p, kappa - delta, v) - delta * (ku + lu);
-        [d0, ku - lu, kv - lv]
-    };
-    let eps = 1e-4;
-    let (m, c, p) = (diff(theta - eps), diff(theta), diff(theta + eps));
-    let dt = |i: usize| (p[i] - m[i]) / (2.0 * eps);
-    let dtt = (p[0] - 2.0 * c[0] + m[0]) / (eps * eps);
-    let s = d[1].signum();
-    let f0 = c[0];
-    let f1 = dt(0) + c[1] * d[1] + c[2] * v1;
-    let f2 = dtt + 2.0 * dt(1) * d[1] + 2.0 * dt(2) * v1 + c[1] * d[2] + c[2] * v2;
-    Crossing {
-        theta: theta.rem_euclid(TAU),
-        alpha,
-        slope: d[1],
-        jumps: [s * f0, s * f1, s * f2],
-        du_jumps: [s * c[1], s * dt(1)],
-        ddu_jumps: [s * c[2], s * dt(2)],
-    }
-}
-
 pub mod exact;
+mod jumps;
+mod search;
+pub(crate) use jumps::{jumps, OrbitAt};
+pub(crate) use search::bracketed_newton;
+pub use search::{find_edge_crossings, EdgeCrossing};
 
 #[cfg(test)]
 mod tests;
