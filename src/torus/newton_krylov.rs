@@ -5,7 +5,7 @@
 //! cheap to factor where the dense Jacobian (`(2 |K| m)²` entries) would not be.
 
 use super::balance::{TorusBalance, TorusWorkspace};
-use super::gmres::gmres;
+use super::gmres::{gmres, GmresOutcome};
 use super::TorusSolution;
 use crate::error::Result;
 use nalgebra::DMatrix;
@@ -19,7 +19,8 @@ pub struct NewtonKrylov {
     /// Most Newton steps.
     pub max_iterations: usize,
     /// Largest relative tolerance of a step's linear solve (the forcing term); each step
-    /// asks for `min(forcing, 0.9 (‖R_k‖/‖R_{k-1}‖)²)` (Eisenstat & Walker 1996, choice 2),
+    /// asks for at most this, less as the last step's linear model proves accurate
+    /// (Eisenstat & Walker 1996, choice 1),
     /// never below what the tolerance needs.
     pub forcing: f64,
     /// GMRES restart length.
@@ -58,7 +59,8 @@ impl NewtonKrylov {
         if len > 0 {
             hb.residual_into(&u, &mut r, true, &mut ws)?;
             let mut step = vec![Complex64::default(); len];
-            let mut previous = f64::INFINITY;
+            // The last step: ‖R‖ before it, the norm its linear model predicted, its forcing.
+            let mut last: Option<(f64, f64, f64)> = None;
             loop {
                 relative = relative_residual(hb, &u, &r);
                 if relative <= self.tolerance {
@@ -70,27 +72,24 @@ impl NewtonKrylov {
                 }
                 iterations += 1;
                 let r_norm = norm(&r);
-                let ratio = r_norm / previous;
-                previous = r_norm;
-                let eta = if ratio.is_finite() {
-                    0.9 * ratio * ratio
-                } else {
-                    self.forcing
-                }
-                .min(self.forcing)
-                .max(0.5 * self.tolerance / relative)
-                .min(0.5);
-                linear += self.direction(hb, &r, eta, &mut step, &mut ws);
-                if !line_search(hb, &mut u, &mut r, &step, (true, 12), &mut ws)? {
+                let eta = forcing(last, r_norm, self.forcing)
+                    .max(0.5 * self.tolerance / relative)
+                    .min(0.5);
+                let outcome = self.direction(hb, &r, eta, &mut step, &mut ws);
+                linear += outcome.iterations;
+                let Some(alpha) = line_search(hb, &mut u, &mut r, &step, (true, 12), &mut ws)?
+                else {
                     break;
-                }
+                };
+                let predicted = r_norm * (1.0 - alpha + alpha * outcome.relative_residual);
+                last = Some((r_norm, predicted, eta));
             }
         }
         finish(hb, &u, &mut ws, relative, converged, iterations, linear)
     }
 
     /// The Newton direction `step ≈ -J⁻¹ r` to the relative tolerance `eta`; returns the
-    /// Jacobian products it took.
+    /// Jacobian products it took and the linear residual it reached.
     fn direction(
         &self,
         hb: &TorusBalance,
@@ -98,7 +97,7 @@ impl NewtonKrylov {
         eta: f64,
         step: &mut [Complex64],
         ws: &mut TorusWorkspace,
-    ) -> usize {
+    ) -> GmresOutcome {
         let blocks = preconditioner(hb, ws);
         let m = hb.coordinates();
         let rhs: Vec<Complex64> = r.iter().map(|v| -v).collect();
@@ -112,8 +111,27 @@ impl NewtonKrylov {
             self.restart,
             self.max_linear,
         )
-        .iterations
     }
+}
+
+/// The forcing term of a step (Eisenstat & Walker 1996, choice 1, with its safeguard): how far
+/// the last step's linear model missed the residual it reached,
+/// `|‖R_k‖ − ‖R_{k−1} + α J s‖| / ‖R_{k−1}‖`, at most `first` (also the first step's). Where the
+/// Jacobian is exact it falls superlinearly; where it is not (the contact-edge correction's
+/// derivative is the derivative of the exact integral, not of its corrected quadrature) it
+/// stops GMRES from solving beyond what the model is worth.
+fn forcing(last: Option<(f64, f64, f64)>, r_norm: f64, first: f64) -> f64 {
+    let Some((previous, predicted, eta)) = last else {
+        return first;
+    };
+    let missed = (r_norm - predicted).abs() / previous;
+    let safeguard = eta.powf(0.5 * (1.0 + 5f64.sqrt()));
+    let eta = if safeguard > 0.1 {
+        missed.max(safeguard)
+    } else {
+        missed
+    };
+    eta.min(first)
 }
 
 /// The unknowns to start from: `start`, or the linear response; an error for a start of
@@ -138,8 +156,9 @@ pub(super) fn relative_residual(hb: &TorusBalance, u: &[Complex64], r: &[Complex
 }
 
 /// Backtracking along `step` from `u` (Armijo on ‖R‖ with a small slope, `halvings`): moves
-/// `u` and its residual `r` (with the Jacobian's samples where `derivatives`) on success;
-/// `false` (and `u`, `r` as they were) where no step lowers ‖R‖.
+/// `u` and its residual `r` (with the Jacobian's samples where `derivatives`) and returns the
+/// fraction of the step taken on success; `None` (and `u`, `r` as they were) where no step
+/// lowers ‖R‖.
 pub(super) fn line_search(
     hb: &TorusBalance,
     u: &mut Vec<Complex64>,
@@ -147,7 +166,7 @@ pub(super) fn line_search(
     step: &[Complex64],
     (derivatives, halvings): (bool, usize),
     ws: &mut TorusWorkspace,
-) -> Result<bool> {
+) -> Result<Option<f64>> {
     let r_norm = norm(r);
     let mut trial = vec![Complex64::default(); u.len()];
     let mut r_trial = vec![Complex64::default(); u.len()];
@@ -160,12 +179,12 @@ pub(super) fn line_search(
         if norm(&r_trial) <= (1.0 - 1e-4 * alpha) * r_norm {
             *u = trial;
             *r = r_trial;
-            return Ok(true);
+            return Ok(Some(alpha));
         }
         alpha *= 0.5;
     }
     hb.residual_into(u, r, derivatives, ws)?;
-    Ok(false)
+    Ok(None)
 }
 
 /// The solution at `u`: full harmonics, truncation estimates, and how the solver got there.
