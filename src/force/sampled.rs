@@ -63,7 +63,7 @@ impl SampledProfile {
     fn index(&self, phi: f64) -> Option<usize> {
         let n = self.values.len();
         let x = (phi - self.phase) / self.teeth * (n as f64 / TAU);
-        let i = x.round();
+        let i = nearest(x);
         ((x - i).abs() <= 1e-7).then(|| (i as i64).rem_euclid(n as i64) as usize)
     }
 
@@ -87,11 +87,20 @@ impl SampledProfile {
     pub(super) fn value(&self, phi: f64) -> f64 {
         let n = self.values.len();
         let x = (phi - self.phase) / self.teeth * (n as f64 / TAU);
-        let i = x.round();
+        let i = nearest(x);
         if (x - i).abs() <= 1e-7 {
             self.values[(i as i64).rem_euclid(n as i64) as usize]
         } else {
             self.fourier.value(phi)
         }
     }
+}
+
+/// The integer nearest to `x` (ties away from zero) for `|x| < 2⁶²`, by conversions rather
+/// than a libm `round` call (this sits in the contact-edge correction's law calls); NaN or
+/// far out of range gives some value `(x - i).abs() > 1e-7` rejects.
+#[inline]
+fn nearest(x: f64) -> f64 {
+    let shifted = if x >= 0.0 { x + 0.5 } else { x - 0.5 };
+    (shifted as i64) as f64
 }

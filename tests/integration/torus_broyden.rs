@@ -45,7 +45,8 @@ fn broyden_agrees_with_newton_krylov_where_the_contact_opens() {
     );
 }
 
-/// The free-free drivetrain at 3000 rpm (three bases, backlash on both stages, closed):
+/// The free-free drivetrain at 3000 rpm (three bases, backlash on both stages, stage 1 losing
+/// contact at its third mesh harmonic):
 /// Broyden converges to Newton–Krylov's solution.
 #[test]
 fn broyden_solves_the_drivetrain() {

@@ -57,7 +57,7 @@ pub fn find_edge_crossings(
         });
     let (mut reach, mut quartic) = (0.0, 0.0);
     for (k, c) in uk.iter().enumerate() {
-        let (kf, a) = (k as f64, c.norm());
+        let (kf, a) = (k as f64, c.norm_sqr().sqrt());
         reach += kf * a;
         quartic += kf * kf * kf * kf * a;
     }
