@@ -36,7 +36,8 @@ struct Arnoldi {
 impl Arnoldi {
     fn new(n: usize, restart: usize) -> Self {
         Self {
-            basis: vec![vec![Complex64::default(); n]; restart + 1],
+            // Grown as the cycle needs it (most directions take a few products, not `restart`).
+            basis: vec![vec![Complex64::default(); n]],
             h: vec![vec![0.0; restart]; restart + 1],
             rotations: vec![(1.0, 0.0); restart],
             g: vec![0.0; restart + 1],
@@ -62,6 +63,9 @@ impl Arnoldi {
         }
         let hk1 = norm(w);
         self.h[k + 1][k] = hk1;
+        if self.basis.len() <= k + 1 {
+            self.basis.push(vec![Complex64::default(); w.len()]);
+        }
         if hk1 > 0.0 {
             for (v, wv) in self.basis[k + 1].iter_mut().zip(w.iter()) {
                 *v = wv / hk1;
