@@ -83,7 +83,6 @@ impl LinePlans {
             line: Vec::new(),
             starts: Vec::new(),
             found: Vec::new(),
-            lines: 0,
         }
     }
 }
@@ -107,8 +106,6 @@ pub(super) struct EdgeBuffers {
     /// line (for the derivative samples).
     starts: Vec<usize>,
     found: Vec<Crossing>,
-    /// Lines corrected so far.
-    pub(super) lines: usize,
 }
 
 impl TorusBalance<'_> {
@@ -159,7 +156,6 @@ impl TorusBalance<'_> {
                 {
                     continue;
                 }
-                edges.lines += 1;
                 let line = |j: usize| start + j * stride;
                 self.line_crossings(act, law, edges, |j| due[line(j)]);
                 if edges.line.is_empty() {
