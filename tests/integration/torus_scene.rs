@@ -318,3 +318,30 @@ fn automatic_caps_in_a_run_up_hold_the_tolerance_at_every_point() {
         }
     }
 }
+
+/// The drivetrain's 200-point run-up 1000 → 6000 rpm (caps 8/4/4): with the contact edges
+/// corrected along each law's axis, every point converges but where the branch ends near
+/// 2836 rpm (arclength stops there; docs/torus.md), which is marked. Sampled plainly, the
+/// edges left 7 points unconverged (2834–2960 and 4769 rpm).
+#[test]
+#[ignore = "release: about 7 s (CI runs it)"]
+fn drivetrain_run_up_converges_but_where_the_branch_ends() {
+    let scene = Scene::from_str(&text("two_stage_train_torus.toml"), "train.toml").unwrap();
+    let settings = hbal::analysis::TorusSweepSettings {
+        from: Some(1000.0),
+        to: 6000.0,
+        points: 200,
+    };
+    let a = hbal::analysis::torus_sweep(&scene, &settings, &mut hbal::analysis::Silent).unwrap();
+    assert_eq!(a.points.len(), 200);
+    let failed: Vec<f64> = a
+        .points
+        .iter()
+        .filter(|p| !p.converged)
+        .map(|p| p.speed)
+        .collect();
+    assert!(
+        failed.len() <= 2 && failed.iter().all(|s| (2830.0..2890.0).contains(s)),
+        "not converged at {failed:?} rpm"
+    );
+}
