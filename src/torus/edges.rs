@@ -13,11 +13,12 @@
 //! crossings θ* of every kink κ by Newton on the series, the jumps of f and of its derivatives
 //! there (with u̇ from its own series along the line, since the other bases turn too) and the
 //! Euler–Maclaurin error of the trapezoid rule, subtracted from the line's harmonics
-//! `m ≤ H_b`. The correction is written back as samples, `δf_j = Re Σ_{m ≤ H_b} δC_m e^{i m θ_j}`:
-//! band-limited below `N_b/2`, so the grid's transform of the corrected samples holds the
-//! corrected line spectrum in every line of the index set. The samples of `∂f/∂u`, `∂f/∂u̇`
-//! are corrected the same way on the bins `m ≤ min(2H_b, N_b/2 - 1)`, so the Jacobian stays
-//! the derivative of the corrected residual.
+//! `m ≤ M = min(H_b + 1, ⌊(N_b - 1)/2⌋)` (the first harmonic beyond the cap is what the
+//! truncation estimate reads). The correction is written back as samples,
+//! `δf_j = Re Σ_{m ≤ M} δC_m e^{i m θ_j}`: band-limited below `N_b/2`, so the grid's transform
+//! of the corrected samples holds the corrected line spectrum in every line of the index set.
+//! The samples of `∂f/∂u`, `∂f/∂u̇` are corrected the same way on the bins
+//! `m ≤ min(2H_b, ⌊(N_b - 1)/2⌋)`, so the Jacobian is the derivative of the exact integral.
 //!
 //! What is left is the trapezoid rule of the other axes over the line integrals, which are
 //! smooth in those angles except where a line grazes an edge (a contact about to open).
@@ -161,12 +162,13 @@ impl TorusBalance<'_> {
                 if edges.line.is_empty() {
                     continue;
                 }
-                // δf_j = Re Σ_{m ≤ H_b} δC_m e^{i m θ_j}: half spectrum Y_0 = δC_0, Y_m = δC_m / 2.
-                let cap = self.set.caps()[b];
+                // δf_j = Re Σ_{m ≤ M} δC_m e^{i m θ_j}: half spectrum Y_0 = δC_0, Y_m = δC_m / 2,
+                // up to the first harmonic beyond the cap (the truncation estimate reads it).
+                let top = (self.set.caps()[b] + 1).min((n - 1) / 2);
                 edges.spec.fill(Complex64::default());
-                kinks::correct_harmonics(&mut edges.spec[..=cap], n, &edges.line);
+                kinks::correct_harmonics(&mut edges.spec[..=top], n, &edges.line);
                 edges.spec[0] = Complex64::new(edges.spec[0].re, 0.0);
-                for y in &mut edges.spec[1..=cap] {
+                for y in &mut edges.spec[1..=top] {
                     *y *= 0.5;
                 }
                 self.line_inverse(b, edges);
@@ -186,7 +188,8 @@ impl TorusBalance<'_> {
     pub(super) fn correct_edge_derivatives(&self, act: &TorusElement, ws: &mut TorusWorkspace) {
         let TorusWorkspace { ge, gde, edges, .. } = ws;
         let (n, stride) = self.axis(act.base);
-        let bins = (2 * self.set.caps()[act.base]).min((n / 2).saturating_sub(1));
+        // Below the Nyquist bin of an even grid; every bin of an odd one.
+        let bins = (2 * self.set.caps()[act.base]).min((n - 1) / 2);
         let mut first = 0;
         while first < edges.found.len() {
             let start = edges.starts[first];

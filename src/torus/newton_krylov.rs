@@ -81,6 +81,7 @@ impl NewtonKrylov {
                 else {
                     break;
                 };
+                // ‖R + α J s‖ ≤ (1 − α) ‖R‖ + α ‖R + J s‖ (exact for a full step).
                 let predicted = r_norm * (1.0 - alpha + alpha * outcome.relative_residual);
                 last = Some((r_norm, predicted, eta));
             }
