@@ -125,7 +125,7 @@ impl TorusBroyden {
                 let mut step: Vec<Complex64> = r.iter().map(|v| -v).collect();
                 h.apply(&mut step);
                 let (u_old, r_old) = (u.clone(), r.clone());
-                if line_search(hb, &mut u, &mut r, &step, (false, 12), &mut ws)?.is_none() {
+                if line_search(hb, &mut u, &mut r, &step, false, &mut ws)?.is_none() {
                     failures += 1;
                     // A full step uphill (non-monotone): the secant pair it gives carries
                     // what the averaged Jacobian misses where a contact opens.

@@ -167,14 +167,10 @@ impl TorusBalance<'_> {
                 let top = (self.set.caps()[b] + 1).min((n - 1) / 2);
                 edges.spec.fill(Complex64::default());
                 kinks::correct_harmonics(&mut edges.spec[..=top], n, &edges.line);
-                edges.spec[0] = Complex64::new(edges.spec[0].re, 0.0);
                 for y in &mut edges.spec[1..=top] {
                     *y *= 0.5;
                 }
-                self.line_inverse(b, edges);
-                for j in 0..n {
-                    fe[line(j)] += edges.work[j];
-                }
+                self.add_line_correction(b, start, fe, edges);
                 edges
                     .starts
                     .extend(std::iter::repeat_n(start, edges.line.len()));
@@ -187,7 +183,7 @@ impl TorusBalance<'_> {
     /// [`correct_edge_forces`](Self::correct_edge_forces) found.
     pub(super) fn correct_edge_derivatives(&self, act: &TorusElement, ws: &mut TorusWorkspace) {
         let TorusWorkspace { ge, gde, edges, .. } = ws;
-        let (n, stride) = self.axis(act.base);
+        let n = self.fft.dims()[act.base];
         // Below the Nyquist bin of an even grid; every bin of an odd one.
         let bins = (2 * self.set.caps()[act.base]).min((n - 1) / 2);
         let mut first = 0;
@@ -203,11 +199,7 @@ impl TorusBalance<'_> {
                 edges.spec.fill(Complex64::default());
                 let crossings = &edges.found[first..last];
                 kinks::correct_spectrum(&mut edges.spec[..=bins], n, crossings, of_velocity);
-                edges.spec[0] = Complex64::new(edges.spec[0].re, 0.0);
-                self.line_inverse(act.base, edges);
-                for j in 0..n {
-                    samples[start + j * stride] += edges.work[j];
-                }
+                self.add_line_correction(act.base, start, samples, edges);
             }
             first = last;
         }
@@ -226,14 +218,19 @@ impl TorusBalance<'_> {
         let n = self.fft.dims()[b];
         let cap = self.set.caps()[b];
         let (forward, inverse) = (&self.line_plans.forward[b], &self.line_plans.inverse[b]);
-        // The line's series of u and of u̇ (u = Re Σ C_m e^{i m θ}: C_0 = X_0/n, C_m = 2 X_m/n).
-        let scale = |m: usize| if m == 0 { 1.0 } else { 2.0 } / n as f64;
+        // The line's series `C_m` of u (then of u̇) from the samples in `work`, its transform
+        // left in `spec`.
+        let series = |work: &mut [f64], spec: &mut [Complex64], scratch: &mut [_], c: &mut [_]| {
+            let _ = forward.process_with_scratch(work, spec, scratch);
+            // u = Re Σ C_m e^{i m θ}: C_0 = X_0/n, C_m = 2 X_m/n.
+            for (m, c) in c.iter_mut().enumerate() {
+                *c = spec[m] * if m == 0 { 1.0 } else { 2.0 } / n as f64;
+            }
+        };
         edges.work[..n].copy_from_slice(&edges.u[..n]);
         let spec = &mut edges.spec[..n / 2 + 1];
-        let _ = forward.process_with_scratch(&mut edges.work[..n], spec, &mut edges.scratch);
-        for (m, c) in edges.uk[..=cap].iter_mut().enumerate() {
-            *c = spec[m] * scale(m);
-        }
+        let uk = &mut edges.uk[..=cap];
+        series(&mut edges.work[..n], spec, &mut edges.scratch, uk);
         // The slope u' = ∂u/∂θ_b at the samples.
         for (m, y) in spec.iter_mut().enumerate() {
             *y = if m <= cap && m > 0 {
@@ -246,10 +243,8 @@ impl TorusBalance<'_> {
         for (j, x) in edges.work[..n].iter_mut().enumerate() {
             *x = rate(j);
         }
-        let _ = forward.process_with_scratch(&mut edges.work[..n], spec, &mut edges.scratch);
-        for (m, c) in edges.vk[..=cap].iter_mut().enumerate() {
-            *c = spec[m] * scale(m);
-        }
+        let vk = &mut edges.vk[..=cap];
+        series(&mut edges.work[..n], spec, &mut edges.scratch, vk);
         edges.edges.clear();
         edges.line.clear();
         let (uk, vk) = (&edges.uk[..=cap], &edges.vk[..=cap]);
@@ -264,22 +259,33 @@ impl TorusBalance<'_> {
                 u: kinks::derivatives(uk, e.theta),
                 v: [v[0], v[1], v[2]],
             };
-            let c = kinks::jumps(law, e.kappa, &orbit, |t| t.rem_euclid(TAU), h);
-            let finite = c.jumps.iter().chain(&c.du_jumps).chain(&c.ddu_jumps);
-            if finite.copied().all(f64::is_finite) {
-                edges.line.push(c);
-            }
+            let angle = |t: f64| t.rem_euclid(TAU);
+            edges
+                .line
+                .extend(kinks::jumps(law, e.kappa, &orbit, angle, h));
         }
     }
 
-    /// `edges.work ← ` the samples of the half spectrum in `edges.spec` (unnormalised inverse).
-    fn line_inverse(&self, b: usize, edges: &mut EdgeBuffers) {
-        let n = self.fft.dims()[b];
+    /// Adds the samples of the half spectrum in `edges.spec` (a real line: the mean's
+    /// imaginary part and the Nyquist bin dropped; unnormalised inverse) to the grid line of
+    /// base b from grid point `start` in `samples`.
+    fn add_line_correction(
+        &self,
+        b: usize,
+        start: usize,
+        samples: &mut [f64],
+        edges: &mut EdgeBuffers,
+    ) {
+        let (n, stride) = self.axis(b);
         let spec = &mut edges.spec[..n / 2 + 1];
+        spec[0].im = 0.0;
         if n % 2 == 0 {
             spec[n / 2] = Complex64::default();
         }
         let inverse = &self.line_plans.inverse[b];
         let _ = inverse.process_with_scratch(spec, &mut edges.work[..n], &mut edges.scratch);
+        for (j, w) in edges.work[..n].iter().enumerate() {
+            samples[start + j * stride] += w;
+        }
     }
 }

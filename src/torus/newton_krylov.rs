@@ -77,8 +77,7 @@ impl NewtonKrylov {
                     .min(0.5);
                 let outcome = self.direction(hb, &r, eta, &mut step, &mut ws);
                 linear += outcome.iterations;
-                let Some(alpha) = line_search(hb, &mut u, &mut r, &step, (true, 12), &mut ws)?
-                else {
+                let Some(alpha) = line_search(hb, &mut u, &mut r, &step, true, &mut ws)? else {
                     break;
                 };
                 // ‖R + α J s‖ ≤ (1 − α) ‖R‖ + α ‖R + J s‖ (exact for a full step).
@@ -156,7 +155,7 @@ pub(super) fn relative_residual(hb: &TorusBalance, u: &[Complex64], r: &[Complex
     norm(r) / norm(hb.load()).max(norm(&lin)).max(f64::MIN_POSITIVE)
 }
 
-/// Backtracking along `step` from `u` (Armijo on ‖R‖ with a small slope, `halvings`): moves
+/// Backtracking along `step` from `u` (Armijo on ‖R‖ with a small slope, 12 halvings): moves
 /// `u` and its residual `r` (with the Jacobian's samples where `derivatives`) and returns the
 /// fraction of the step taken on success; `None` (and `u`, `r` as they were) where no step
 /// lowers ‖R‖.
@@ -165,14 +164,14 @@ pub(super) fn line_search(
     u: &mut Vec<Complex64>,
     r: &mut Vec<Complex64>,
     step: &[Complex64],
-    (derivatives, halvings): (bool, usize),
+    derivatives: bool,
     ws: &mut TorusWorkspace,
 ) -> Result<Option<f64>> {
     let r_norm = norm(r);
     let mut trial = vec![Complex64::default(); u.len()];
     let mut r_trial = vec![Complex64::default(); u.len()];
     let mut alpha = 1.0;
-    for _ in 0..halvings {
+    for _ in 0..12 {
         for ((t, x), s) in trial.iter_mut().zip(u.iter()).zip(step) {
             *t = x + s * alpha;
         }

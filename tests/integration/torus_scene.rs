@@ -150,17 +150,22 @@ fn one_base_equals_the_one_frequency_engine() {
     }
 }
 
+/// The torus example scene with automatic caps to `tolerance`.
+fn auto_caps_scene(tolerance: &str) -> Scene {
+    let base = text("two_stage_train_torus.toml");
+    let auto = base.replace(
+        "caps = { engine = 8, stage1 = 4, stage2 = 4 } }",
+        &format!("caps = {{ engine = 8, stage1 = 4, stage2 = 4 }}, auto = true, tolerance = {tolerance} }}"),
+    );
+    assert_ne!(auto, base);
+    Scene::from_str(&auto, "train.toml").unwrap()
+}
+
 /// Automatic caps raise the caps of the bases whose estimate is above the tolerance, and stop
 /// below it.
 #[test]
 fn automatic_caps_reach_the_tolerance() {
-    let base = text("two_stage_train_torus.toml");
-    let auto = base.replace(
-        "harmonics = { bases = \"torus\", caps = { engine = 8, stage1 = 4, stage2 = 4 } }",
-        "harmonics = { bases = \"torus\", caps = { engine = 8, stage1 = 4, stage2 = 4 }, auto = true, tolerance = 2e-2 }",
-    );
-    assert_ne!(auto, base);
-    let scene = Scene::from_str(&auto, "train.toml").unwrap();
+    let scene = auto_caps_scene("2e-2");
     let a = torus_solve(&scene, &TorusSolveSettings::default()).unwrap();
     assert!(a.caps_stopped.is_none(), "{:?}", a.caps_stopped);
     assert!(a.levels.len() >= 2, "{:?}", a.levels);
@@ -292,13 +297,7 @@ fn automatic_caps_in_a_run_up_hold_the_tolerance_at_every_point() {
             self.0.push(what.to_string());
         }
     }
-    let base = text("two_stage_train_torus.toml");
-    let auto = base.replace(
-        "caps = { engine = 8, stage1 = 4, stage2 = 4 } }",
-        "caps = { engine = 8, stage1 = 4, stage2 = 4 }, auto = true, tolerance = 5e-2 }",
-    );
-    assert_ne!(auto, base);
-    let scene = Scene::from_str(&auto, "train.toml").unwrap();
+    let scene = auto_caps_scene("5e-2");
     let settings = hbal::analysis::TorusSweepSettings {
         from: Some(1000.0),
         to: 6000.0,

@@ -21,14 +21,15 @@ pub(crate) struct OrbitAt {
 }
 
 /// `[f]`, `[f']`, `[f'']` in θ along the orbit at its crossing of `kappa`, and the jumps of
-/// `∂f/∂u`, `∂f/∂u̇`; `angle(θ)` is the law's own angle at θ, `h` the sample spacing.
+/// `∂f/∂u`, `∂f/∂u̇`; `angle(θ)` is the law's own angle at θ, `h` the sample spacing. `None`
+/// where a jump is not finite (the crossing is then left uncorrected).
 pub(crate) fn jumps(
     law: &dyn ForceLaw,
     kappa: f64,
     orbit: &OrbitAt,
     angle: impl Fn(f64) -> f64,
     h: f64,
-) -> Crossing {
+) -> Option<Crossing> {
     let (theta, d) = (orbit.theta, orbit.u);
     // One-sided values at κ ± δ, δ a millionth of the coordinate's change over a sample (so
     // the result does not depend on the units of u); the O(δ) slope is taken out below.
@@ -54,12 +55,14 @@ pub(crate) fn jumps(
     let f0 = c[0];
     let f1 = dt(0) + c[1] * d[1] + c[2] * v1;
     let f2 = dtt + 2.0 * dt(1) * d[1] + 2.0 * dt(2) * v1 + c[1] * d[2] + c[2] * v2;
-    Crossing {
+    let c = Crossing {
         theta: theta.rem_euclid(TAU),
         alpha: orbit.alpha,
         slope: d[1],
         jumps: [s * f0, s * f1, s * f2],
         du_jumps: [s * c[1], s * dt(1)],
         ddu_jumps: [s * c[2], s * dt(2)],
-    }
+    };
+    let mut all = c.jumps.iter().chain(&c.du_jumps).chain(&c.ddu_jumps);
+    all.all(|v| v.is_finite()).then_some(c)
 }

@@ -257,16 +257,7 @@ pub fn crossing_jumps(
             v: [fundamental * d[1], fundamental * d[2], fundamental * d[3]],
         };
         let shaft = |t: f64| (nu as f64 * t).rem_euclid(TAU);
-        let c = jumps(law, e.kappa, &orbit, shaft, h);
-        let finite = c
-            .jumps
-            .iter()
-            .chain(&c.du_jumps)
-            .chain(&c.ddu_jumps)
-            .all(|v| v.is_finite());
-        if finite {
-            out.push(c);
-        }
+        out.extend(jumps(law, e.kappa, &orbit, shaft, h));
     }
 }
 
