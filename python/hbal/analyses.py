@@ -1,0 +1,185 @@
+"""The analyses, with the command line's options (``hbal solve``, ``sweep``, ``modes``,
+``compare``): each runs in the Rust library with the GIL released and returns a result
+object. Bad input raises :class:`hbal.InputError` (a ``ValueError``) before any work; a
+failure after the input was checked raises :class:`hbal.NumericalError`; a marked result
+(not converged, a branch that stopped) is returned with ``exit_code == 1``.
+
+Option names are the command line's, with ``_`` for ``-``; ``--from`` is ``start`` (``from``
+is a Python keyword).
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Sequence
+
+from . import _hbal
+from .results import (
+    CompareResult,
+    ModesResult,
+    ParameterSweepResult,
+    SolveResult,
+    SweepResult,
+    TorusSolveResult,
+    TorusSweepResult,
+)
+from .scene import Scene
+
+
+def _scene(scene) -> Scene:
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, dict):
+        return Scene.from_dict(scene)
+    if isinstance(scene, str) or hasattr(scene, "__fspath__"):
+        return Scene.load(scene)
+    raise TypeError(f"scene: expected an hbal.Scene, a dict or a path, got {type(scene).__name__}")
+
+
+def solve(
+    scene,
+    *,
+    method: str | None = None,
+    harmonics: int | str | None = None,
+    samples: int | None = None,
+    tolerance: float | None = None,
+    formulation: str | None = None,
+    stability: bool = True,
+    fallback: bool = True,
+) -> SolveResult | TorusSolveResult:
+    """One periodic solution with its error estimate, Floquet stability and element outputs
+    (``hbal solve``). ``harmonics`` is H or ``"auto"``, ``"auto:harmonics"``, ...;
+    ``stability=False`` is ``--no-stability``, ``fallback=False`` ``--no-fallback``."""
+    s = _scene(scene)
+    record, code = _hbal.solve(
+        s._handle,
+        method=method,
+        harmonics=harmonics,
+        samples=samples,
+        tolerance=tolerance,
+        formulation=formulation,
+        stability=stability,
+        fallback=fallback,
+    )
+    return (TorusSolveResult if s.on_torus else SolveResult)(record, code)
+
+
+def sweep(
+    scene,
+    to: float,
+    *,
+    start: float | None = None,
+    harmonics: int | str | None = None,
+    samples: int | None = None,
+    tolerance: float | None = None,
+    formulation: str | None = None,
+    stability: bool = True,
+    stability_orbit: str = "exact",
+    max_points: int | None = None,
+    max_step: float = 0.5,
+    points: int = 101,
+    all_branches: bool = False,
+    error_estimate: bool = True,
+    output: str | None = None,
+    dofs: str | Sequence[str] | None = None,
+    progress: Callable[[float, str], None] | None = None,
+) -> SweepResult | TorusSweepResult:
+    """The response over speed from ``start`` (default the scene's speed) to ``to``, in the
+    scene's unit, through turning points, with stability (``hbal sweep``).
+    ``progress(fraction, stage)`` is called along the way; Ctrl-C stops the sweep and raises
+    ``KeyboardInterrupt``."""
+    s = _scene(scene)
+    if dofs is not None and not isinstance(dofs, str):
+        dofs = ",".join(dofs)
+    record, code = _hbal.sweep(
+        s._handle,
+        float(to),
+        start=None if start is None else float(start),
+        harmonics=harmonics,
+        samples=samples,
+        tolerance=tolerance,
+        formulation=formulation,
+        stability=stability,
+        stability_orbit=stability_orbit,
+        max_points=max_points,
+        max_step=max_step,
+        points=points,
+        all_branches=all_branches,
+        error_estimate=error_estimate,
+        output=output,
+        dofs=dofs,
+        progress=progress,
+    )
+    return (TorusSweepResult if s.on_torus else SweepResult)(record, code)
+
+
+def parameter_sweep(
+    scene,
+    parameter: str,
+    start: float,
+    to: float,
+    *,
+    points: int = 101,
+    harmonics: int | str | None = None,
+    samples: int | None = None,
+    formulation: str | None = None,
+    stability: bool = True,
+    dofs: str | Sequence[str] | None = None,
+    progress: Callable[[float, str], None] | None = None,
+) -> ParameterSweepResult:
+    """The response over one numeric scene field (``hbal sweep --parameter``), e.g.
+    ``elements[0].k``, at ``points`` evenly spaced values."""
+    s = _scene(scene)
+    if dofs is not None and not isinstance(dofs, str):
+        dofs = ",".join(dofs)
+    record, code = _hbal.parameter_sweep(
+        s._handle,
+        parameter,
+        float(start),
+        float(to),
+        points=points,
+        harmonics=harmonics,
+        samples=samples,
+        formulation=formulation,
+        stability=stability,
+        dofs=dofs,
+        progress=progress,
+    )
+    return ParameterSweepResult(record, code)
+
+
+def modes(
+    scene,
+    *,
+    start: float | None = None,
+    to: float | None = None,
+    max_hz: float | None = None,
+    formulation: str | None = None,
+) -> ModesResult:
+    """Natural frequencies and mode shapes about the periodic solution and the critical
+    speeds between ``start`` and ``to`` (``hbal modes``)."""
+    s = _scene(scene)
+    record, code = _hbal.modes(s._handle, start=start, to=to, max_hz=max_hz, formulation=formulation)
+    return ModesResult(record, code)
+
+
+def compare(
+    scene,
+    *,
+    methods: Sequence[str] | None = None,
+    harmonics: int | str | None = None,
+    samples: int | None = None,
+    tolerance: float | None = None,
+    formulation: str | None = None,
+) -> CompareResult:
+    """Every solver (or ``methods``) and the time-domain reference, with their errors
+    (``hbal compare``)."""
+    s = _scene(scene)
+    record, code = _hbal.compare(
+        s._handle,
+        methods=None if methods is None else list(methods),
+        harmonics=harmonics,
+        samples=samples,
+        tolerance=tolerance,
+        formulation=formulation,
+    )
+    return CompareResult(record, code)

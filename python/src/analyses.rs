@@ -1,0 +1,294 @@
+//! The analyses of `hbal.solve`, `hbal.sweep`, `hbal.parameter_sweep`, `hbal.modes` and
+//! `hbal.compare`: the library's `hbal::analysis` functions with the command line's options,
+//! run with the GIL released. Each returns `(record, exit_code)`: the analysis's serde form
+//! (what `hbal ... --json` prints, as Python objects, bit for bit) and the exit code of the
+//! command-line contract (0, or 1 where the result is marked).
+
+use crate::errors::InputError;
+use crate::progress::PyProgress;
+use crate::scene::{error, SceneHandle};
+use crate::value::to_python;
+use hbal::analysis as an;
+use hbal::scene::{HarmonicsOverride, Overrides};
+use hbal::Formulation;
+use pyo3::prelude::*;
+use serde::Serialize;
+
+/// The most points of a sweep (as `--points`, `--max-points` of the command line).
+const MAX_SWEEP_POINTS: usize = 100_000;
+
+/// The record and exit code of an analysis, or its error (a Python law's failure first).
+fn finish<'py, T: Serialize>(
+    py: Python<'py>,
+    handle: &SceneHandle,
+    result: hbal::Result<T>,
+    exit_code: impl FnOnce(&T) -> u8,
+) -> PyResult<(Bound<'py, PyAny>, u8)> {
+    if let Some(e) = handle.law_failure() {
+        return Err(e);
+    }
+    let analysis = result.map_err(|e| error(py, handle, e))?;
+    let code = exit_code(&analysis);
+    let value = serde_json::to_value(&analysis)
+        .map_err(|e| crate::errors::NumericalError::new_err(e.to_string()))?;
+    Ok((to_python(py, &value)?, code))
+}
+
+fn invalid(option: &str, reason: impl std::fmt::Display) -> PyErr {
+    InputError::new_err(format!("{option}: {reason}"))
+}
+
+/// The solver overrides (`--method`, `--harmonics`, `--samples`, `--tolerance`,
+/// `--formulation`).
+fn overrides(
+    method: Option<String>,
+    harmonics: Option<&Bound<'_, PyAny>>,
+    samples: Option<usize>,
+    tolerance: Option<f64>,
+    formulation: Option<&str>,
+) -> PyResult<Overrides> {
+    let harmonics = harmonics
+        .map(|h| -> PyResult<HarmonicsOverride> {
+            let text = h.str()?.to_string();
+            text.parse().map_err(|e| invalid("harmonics", e))
+        })
+        .transpose()?;
+    Ok(Overrides {
+        method,
+        harmonics,
+        samples,
+        tolerance,
+        formulation: formulation_of(formulation)?,
+    })
+}
+
+fn formulation_of(name: Option<&str>) -> PyResult<Formulation> {
+    name.unwrap_or("auto")
+        .parse()
+        .map_err(|e| invalid("formulation", e))
+}
+
+fn points_in_range(option: &str, n: usize, min: usize) -> PyResult<usize> {
+    if (min..=MAX_SWEEP_POINTS).contains(&n) {
+        Ok(n)
+    } else {
+        Err(invalid(
+            option,
+            format!("must be {min} to {MAX_SWEEP_POINTS}, got {n}"),
+        ))
+    }
+}
+
+/// One periodic solution (`hbal solve`): on several base frequencies where the scene is.
+#[pyfunction]
+#[pyo3(signature = (scene, *, method=None, harmonics=None, samples=None, tolerance=None,
+    formulation=None, stability=true, fallback=true))]
+#[allow(clippy::too_many_arguments)]
+pub fn solve<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, SceneHandle>,
+    method: Option<String>,
+    harmonics: Option<&Bound<'py, PyAny>>,
+    samples: Option<usize>,
+    tolerance: Option<f64>,
+    formulation: Option<&str>,
+    stability: bool,
+    fallback: bool,
+) -> PyResult<(Bound<'py, PyAny>, u8)> {
+    let handle = scene.get();
+    let o = overrides(method, harmonics, samples, tolerance, formulation)?;
+    let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
+    let s: &hbal::scene::Scene = &built;
+    if s.torus.is_some() {
+        let refused = [("fallback", !fallback)];
+        if let Some((name, _)) = refused.iter().find(|r| r.1) {
+            return Err(invalid(name, "applies to one fundamental"));
+        }
+        let settings = an::TorusSolveSettings { speed: None };
+        let result = py.detach(|| an::torus_solve(s, &settings));
+        return finish(py, handle, result, |a| a.exit_code());
+    }
+    let settings = an::SolveSettings {
+        start: None,
+        stability,
+        fallback,
+        formulation: o.formulation,
+    };
+    let result = py.detach(|| an::solve(s, &settings));
+    finish(py, handle, result, |a| a.exit_code())
+}
+
+/// A speed sweep (`hbal sweep --to`): through turning points with stability, or at evenly
+/// spaced speeds on several base frequencies.
+#[pyfunction]
+#[pyo3(signature = (scene, to, *, start=None, harmonics=None, samples=None, tolerance=None,
+    formulation=None, stability=true, stability_orbit="exact", max_points=None, max_step=0.5,
+    points=101, all_branches=false, error_estimate=true, output=None, dofs=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn sweep<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, SceneHandle>,
+    to: f64,
+    start: Option<f64>,
+    harmonics: Option<&Bound<'py, PyAny>>,
+    samples: Option<usize>,
+    tolerance: Option<f64>,
+    formulation: Option<&str>,
+    stability: bool,
+    stability_orbit: &str,
+    max_points: Option<usize>,
+    max_step: f64,
+    points: usize,
+    all_branches: bool,
+    error_estimate: bool,
+    output: Option<String>,
+    dofs: Option<String>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Bound<'py, PyAny>, u8)> {
+    let handle = scene.get();
+    // The sweep's tolerance is its corrector's; the scene's solver is not used.
+    let o = overrides(None, harmonics, samples, None, formulation)?;
+    let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
+    let s: &hbal::scene::Scene = &built;
+    let points = points_in_range("points", points, 2)?;
+    let max_points = max_points
+        .map(|n| points_in_range("max_points", n, 1))
+        .transpose()?;
+    let orbit = match stability_orbit {
+        "exact" => hbal::stability::Orbit::Exact,
+        "harmonic" => hbal::stability::Orbit::Harmonic,
+        other => {
+            return Err(invalid(
+                "stability_orbit",
+                format!("expected `exact` or `harmonic`, got `{other}`"),
+            ))
+        }
+    };
+    let mut observer = PyProgress::new(progress);
+    if s.torus.is_some() {
+        let settings = an::TorusSweepSettings {
+            from: start,
+            to,
+            points,
+        };
+        let result = py.detach(|| an::torus_sweep(s, &settings, &mut observer));
+        observer.raise()?;
+        return finish(py, handle, result, |a| a.exit_code());
+    }
+    let settings = an::SweepSettings {
+        from: start,
+        stability,
+        orbit,
+        max_points,
+        max_step,
+        points,
+        all_branches,
+        error_estimate,
+        formulation: o.formulation,
+        tolerance,
+        output,
+        dofs,
+        cancel: observer.cancel.clone(),
+        ..an::SweepSettings::to(to)
+    };
+    an::check_sweep(s, &settings).map_err(|e| error(py, handle, e))?;
+    let result = py.detach(|| an::sweep(s, &settings, &mut observer));
+    observer.raise()?;
+    finish(py, handle, result, |a| a.exit_code())
+}
+
+/// A sweep of one numeric scene field (`hbal sweep --parameter`).
+#[pyfunction]
+#[pyo3(signature = (scene, parameter, start, to, *, points=101, harmonics=None, samples=None,
+    formulation=None, stability=true, dofs=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn parameter_sweep<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, SceneHandle>,
+    parameter: String,
+    start: f64,
+    to: f64,
+    points: usize,
+    harmonics: Option<&Bound<'py, PyAny>>,
+    samples: Option<usize>,
+    formulation: Option<&str>,
+    stability: bool,
+    dofs: Option<String>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Bound<'py, PyAny>, u8)> {
+    let handle = scene.get();
+    let mut observer = PyProgress::new(progress);
+    let settings = an::ParameterSweepSettings {
+        parameter,
+        from: start,
+        to,
+        points: points_in_range("points", points, 2)?,
+        stability,
+        overrides: overrides(None, harmonics, samples, None, formulation)?,
+        dofs,
+        cancel: observer.cancel.clone(),
+    };
+    let (doc, file) = (&handle.document, handle.file.as_str());
+    an::check_parameter_sweep(doc, file, &settings).map_err(|e| error(py, handle, e))?;
+    let result = py.detach(|| an::parameter_sweep(doc, file, &settings, &mut observer));
+    observer.raise()?;
+    finish(py, handle, result, |a| a.exit_code())
+}
+
+/// Natural frequencies and mode shapes about the periodic solution, critical speeds
+/// (`hbal modes`).
+#[pyfunction]
+#[pyo3(signature = (scene, *, start=None, to=None, max_hz=None, formulation=None))]
+pub fn modes<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, SceneHandle>,
+    start: Option<f64>,
+    to: Option<f64>,
+    max_hz: Option<f64>,
+    formulation: Option<&str>,
+) -> PyResult<(Bound<'py, PyAny>, u8)> {
+    let handle = scene.get();
+    let settings = an::ModesSettings {
+        from: start,
+        to,
+        max_hz,
+        formulation: formulation_of(formulation)?,
+    };
+    let s = &handle.scene;
+    let result = py.detach(|| an::modes(s, &settings));
+    finish(py, handle, result, |_| 0)
+}
+
+/// Every solver (or those of `methods`) and the time-domain reference (`hbal compare`).
+#[pyfunction]
+#[pyo3(signature = (scene, *, methods=None, harmonics=None, samples=None, tolerance=None,
+    formulation=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn compare<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, SceneHandle>,
+    methods: Option<Vec<String>>,
+    harmonics: Option<&Bound<'py, PyAny>>,
+    samples: Option<usize>,
+    tolerance: Option<f64>,
+    formulation: Option<&str>,
+) -> PyResult<(Bound<'py, PyAny>, u8)> {
+    let handle = scene.get();
+    let o = overrides(None, harmonics, samples, None, formulation)?;
+    let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
+    let s: &hbal::scene::Scene = &built;
+    let settings = an::CompareSettings {
+        methods,
+        tolerance,
+        formulation: o.formulation,
+    };
+    let result = py.detach(|| an::compare(s, &settings));
+    finish(py, handle, result, |a| a.exit_code())
+}
+
+/// Checks the scene as a solve would before its first iteration (`hbal check`).
+#[pyfunction]
+pub fn check(py: Python<'_>, scene: &Bound<'_, SceneHandle>) -> PyResult<()> {
+    let handle = scene.get();
+    an::check(&handle.scene).map_err(|e| error(py, handle, e))
+}

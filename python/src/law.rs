@@ -1,0 +1,332 @@
+//! Force laws written in Python: the element type `python` of a scene,
+//! `{ type = "python", law = "name" }`, whose `name` is a vectorised Python function
+//! `law(theta, u, du) -> (f, df_du, df_ddu)` given with the scene (`Scene(..., laws=...)`).
+//!
+//! The AFT calls it once per element and pass with numpy arrays of θ, u, u̇ (the
+//! [`ForceLaw::force_batch`] and [`ForceLaw::derivatives_batch`] hooks); the force and the
+//! derivatives of one pass come from one call (the second hook reuses the first's arrays
+//! when its samples are the same). Each of the three returned values is a float64 array of
+//! the samples' length or a number for all of them. The time-domain reference and the
+//! Floquet analysis call it with one sample at a time.
+//!
+//! A law that raises, or returns something of the wrong length or a non-finite value, gives
+//! NaN to the solver (which stops on it, never reporting it converged), and its failure is
+//! kept in the scene's [`FailureSlot`]: the analysis then raises `LawError` naming the law,
+//! with the law's own exception as its cause.
+
+use crate::errors::LawError;
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyFloat;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// The first failure of any Python law of one scene.
+#[derive(Debug, Default)]
+pub struct FailureSlot(Mutex<Option<PyErr>>);
+
+impl FailureSlot {
+    fn record(&self, e: PyErr) {
+        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        if slot.is_none() {
+            *slot = Some(e);
+        }
+    }
+
+    /// The failure, if a law failed (the slot is emptied).
+    pub fn take(&self) -> Option<PyErr> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).take()
+    }
+}
+
+/// A law as registered for a scene: the callable and the scene's failure slot.
+#[derive(Debug)]
+pub struct Registered {
+    pub callable: Py<PyAny>,
+    pub slot: Arc<FailureSlot>,
+}
+
+/// Laws by registry key (`name#n`, unique per scene handle): the scene documents given to
+/// the library carry these keys, so that a law is found wherever the library builds the
+/// scene again (a parameter sweep builds it at every value).
+fn registry() -> &'static Mutex<HashMap<String, Arc<Registered>>> {
+    static REGISTRY: OnceLock<Mutex<HashMap<String, Arc<Registered>>>> = OnceLock::new();
+    REGISTRY.get_or_init(Default::default)
+}
+
+/// Registers `law` under `key`.
+pub fn register(key: String, law: Registered) {
+    lock().insert(key, Arc::new(law));
+}
+
+/// Removes the laws under `keys` (the scene handle is gone).
+pub fn unregister(keys: &[String]) {
+    let mut map = lock();
+    for k in keys {
+        map.remove(k);
+    }
+}
+
+fn lock() -> std::sync::MutexGuard<'static, HashMap<String, Arc<Registered>>> {
+    registry().lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// The user's name of a registry key.
+pub fn user_name(key: &str) -> &str {
+    key.split('#').next().unwrap_or(key)
+}
+
+/// What a scene element of type `python` holds.
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Spec {
+    /// The law's name in the scene's `laws`.
+    law: String,
+    /// Values of u where the law is not smooth (contact edges), for the Floquet analysis.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    kinks: Vec<f64>,
+}
+
+/// The arrays of the last call, reused when the derivatives of the same samples follow.
+#[derive(Debug, Default)]
+struct LastCall {
+    input: [Vec<f64>; 3],
+    output: [Vec<f64>; 3],
+}
+
+/// A force law evaluated by a Python function.
+#[derive(Debug, serde::Deserialize)]
+#[serde(try_from = "Spec")]
+pub struct PythonLaw {
+    key: String,
+    kinks: Vec<f64>,
+    law: Arc<Registered>,
+    last: Mutex<LastCall>,
+}
+
+impl TryFrom<Spec> for PythonLaw {
+    type Error = String;
+    fn try_from(spec: Spec) -> Result<Self, String> {
+        let law = lock().get(&spec.law).cloned().ok_or_else(|| {
+            format!(
+                "no Python law named `{}`: give it in the scene's `laws` (a dict of names and functions)",
+                user_name(&spec.law)
+            )
+        })?;
+        if let Some(k) = spec.kinks.iter().find(|k| !k.is_finite()) {
+            return Err(format!("kinks must be finite, got {k}"));
+        }
+        Ok(PythonLaw {
+            key: spec.law,
+            kinks: spec.kinks,
+            law,
+            last: Mutex::default(),
+        })
+    }
+}
+
+impl serde::Serialize for PythonLaw {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        Spec {
+            law: user_name(&self.key).to_string(),
+            kinks: self.kinks.clone(),
+        }
+        .serialize(s)
+    }
+}
+
+impl PythonLaw {
+    /// f, ∂f/∂u, ∂f/∂u̇ at the samples, into `out` (NaN and the failure recorded on error).
+    fn evaluate(&self, theta: &[f64], u: &[f64], du: &[f64], want: Want, out: Out<'_>) {
+        let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
+        let same = last.input[0] == theta && last.input[1] == u && last.input[2] == du;
+        if !same {
+            let result = Python::attach(|py| self.call(py, theta, u, du));
+            match result {
+                Ok(output) => {
+                    last.input = [theta.to_vec(), u.to_vec(), du.to_vec()];
+                    last.output = output;
+                }
+                Err(e) => {
+                    last.input = Default::default();
+                    self.law.slot.record(e);
+                    out.fill(f64::NAN);
+                    return;
+                }
+            }
+        }
+        match want {
+            Want::Force => out.force.copy_from_slice(&last.output[0]),
+            Want::Derivatives => {
+                out.dfdu.copy_from_slice(&last.output[1]);
+                out.dfddu.copy_from_slice(&last.output[2]);
+            }
+        }
+    }
+
+    /// One call of the Python function, its three results checked.
+    fn call(
+        &self,
+        py: Python<'_>,
+        theta: &[f64],
+        u: &[f64],
+        du: &[f64],
+    ) -> PyResult<[Vec<f64>; 3]> {
+        let name = user_name(&self.key);
+        let args = (
+            PyArray1::from_slice(py, theta),
+            PyArray1::from_slice(py, u),
+            PyArray1::from_slice(py, du),
+        );
+        let returned = self.law.callable.bind(py).call1(args).map_err(|e| {
+            let err = LawError::new_err(format!("Python law `{name}` raised: {e}"));
+            err.set_cause(py, Some(e));
+            err
+        })?;
+        let parts: Vec<Bound<'_, PyAny>> = returned
+            .try_iter()
+            .and_then(|it| it.collect::<PyResult<Vec<_>>>())
+            .ok()
+            .filter(|p| p.len() == 3)
+            .ok_or_else(|| {
+                LawError::new_err(format!(
+                    "Python law `{name}` must return three values (f, df_du, df_ddu), got {}",
+                    returned
+                        .get_type()
+                        .name()
+                        .map(|n| n.to_string())
+                        .unwrap_or_default()
+                ))
+            })?;
+        let what = ["f", "df_du", "df_ddu"];
+        let mut output: [Vec<f64>; 3] = Default::default();
+        for (j, part) in parts.iter().enumerate() {
+            output[j] = samples(py, part, theta.len()).map_err(|reason| {
+                LawError::new_err(format!("Python law `{name}`: {} {reason}", what[j]))
+            })?;
+            if let Some(i) = output[j].iter().position(|x| !x.is_finite()) {
+                return Err(LawError::new_err(format!(
+                    "Python law `{name}`: {} is {} at theta = {}, u = {}, du = {}",
+                    what[j], output[j][i], theta[i], u[i], du[i]
+                )));
+            }
+        }
+        Ok(output)
+    }
+}
+
+/// The `n` values of one returned part: a float64 array of length `n`, another array or
+/// sequence numpy converts to one, or one number for all samples.
+fn samples(py: Python<'_>, part: &Bound<'_, PyAny>, n: usize) -> Result<Vec<f64>, String> {
+    if let Ok(x) = part.cast::<PyFloat>() {
+        return Ok(vec![x.value(); n]);
+    }
+    let array: PyReadonlyArray1<'_, f64> = match part.extract() {
+        Ok(a) => a,
+        Err(_) => {
+            let np = py.import("numpy").map_err(|e| e.to_string())?;
+            let converted = np
+                .call_method1("asarray", (part, "float64"))
+                .map_err(|e| format!("is not a float array: {e}"))?;
+            if converted
+                .getattr("ndim")
+                .and_then(|d| d.extract::<usize>())
+                .ok()
+                == Some(0)
+            {
+                let x: f64 = converted.extract().map_err(|e: PyErr| e.to_string())?;
+                return Ok(vec![x; n]);
+            }
+            converted
+                .extract()
+                .map_err(|_| "must be a one-dimensional array".to_string())?
+        }
+    };
+    let view = array.as_array();
+    if view.len() != n {
+        return Err(format!("has {} values for {n} samples", view.len()));
+    }
+    Ok(view.iter().copied().collect())
+}
+
+#[derive(Clone, Copy)]
+enum Want {
+    Force,
+    Derivatives,
+}
+
+struct Out<'a> {
+    force: &'a mut [f64],
+    dfdu: &'a mut [f64],
+    dfddu: &'a mut [f64],
+}
+
+impl Out<'_> {
+    fn fill(self, x: f64) {
+        self.force.fill(x);
+        self.dfdu.fill(x);
+        self.dfddu.fill(x);
+    }
+}
+
+#[typetag::serde(name = "python")]
+impl hbal::force::ForceLaw for PythonLaw {
+    fn force(&self, theta: f64, u: f64, du: f64) -> f64 {
+        let mut f = [0.0];
+        self.force_batch(&[theta], &[u], &[du], &mut f);
+        f[0]
+    }
+
+    fn force_batch(&self, theta: &[f64], u: &[f64], du: &[f64], out: &mut [f64]) {
+        let out = Out {
+            force: out,
+            dfdu: &mut [],
+            dfddu: &mut [],
+        };
+        self.evaluate(theta, u, du, Want::Force, out);
+    }
+
+    fn derivatives(&self, theta: f64, u: f64, du: f64) -> (f64, f64) {
+        let (mut a, mut b) = ([0.0], [0.0]);
+        self.derivatives_batch(&[theta], &[u], &[du], &mut a, &mut b);
+        (a[0], b[0])
+    }
+
+    fn derivatives_batch(
+        &self,
+        theta: &[f64],
+        u: &[f64],
+        du: &[f64],
+        dfdu: &mut [f64],
+        dfddu: &mut [f64],
+    ) {
+        let out = Out {
+            force: &mut [],
+            dfdu,
+            dfddu,
+        };
+        self.evaluate(theta, u, du, Want::Derivatives, out);
+    }
+
+    /// The library's default (the 64-point average of the linearisation at rest) in one call.
+    fn linear_part(&self) -> hbal::force::LinearPart {
+        const POINTS: usize = 64;
+        let theta: Vec<f64> = (0..POINTS)
+            .map(|j| std::f64::consts::TAU * j as f64 / POINTS as f64)
+            .collect();
+        let zero = vec![0.0; POINTS];
+        let (mut f, mut k, mut d) = (zero.clone(), zero.clone(), zero.clone());
+        self.force_batch(&theta, &zero, &zero, &mut f);
+        self.derivatives_batch(&theta, &zero, &zero, &mut k, &mut d);
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / POINTS as f64;
+        hbal::force::LinearPart {
+            stiffness: mean(&k),
+            damping: mean(&d),
+            offset: mean(&f),
+        }
+    }
+
+    fn kinks(&self) -> Vec<f64> {
+        self.kinks.clone()
+    }
+}

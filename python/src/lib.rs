@@ -1,0 +1,35 @@
+//! The extension module `hbal._hbal`: a thin layer over the hbal library for the Python
+//! package `hbal` (python/hbal). Scenes are built from Python documents ([`value`],
+//! [`scene`]), analyses run with the GIL released and return their serde records
+//! ([`analyses`]), force laws may be Python functions ([`law`]), errors are Python
+//! exceptions by the exit-code contract ([`errors`]), sweeps report progress and stop on
+//! Ctrl-C ([`progress`]).
+
+mod analyses;
+mod errors;
+mod law;
+mod progress;
+mod scene;
+mod value;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _hbal(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    errors::register(m)?;
+    m.add_class::<scene::SceneHandle>()?;
+    m.add_function(wrap_pyfunction!(scene::build_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::parse_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::read_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::document_to_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::set_parameter, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::solve, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::parameter_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::modes, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::check, m)?)?;
+    m.add("SCHEMA_VERSION", hbal::analysis::SCHEMA_VERSION)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
