@@ -53,6 +53,8 @@ class Scene:
     ) -> None:
         if not isinstance(document, Mapping):
             raise TypeError(f"document: expected a dict, got {type(document).__name__}")
+        self._info: dict = {"description": None, "dofs": [], "elements": []}
+        self._document = {}
         self._laws = dict(laws or {})
         for name, law in self._laws.items():
             check_law(name, law)

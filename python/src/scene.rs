@@ -126,12 +126,16 @@ pub fn build_scene(
             keys.push(key);
         }
     }
+    // Building calls the laws (their linear part): a law's failure is the error to raise.
     let built = Scene::from_value(document.clone(), file);
-    let scene = match built {
-        Ok(scene) => scene,
-        Err(e) => {
+    let failed = slot.take();
+    let scene = match (built, failed) {
+        (Ok(scene), None) => scene,
+        (built, failed) => {
             law::unregister(&keys);
-            return Err(scene_error(py, &unkeyed(e)));
+            return Err(failed.unwrap_or_else(|| {
+                scene_error(py, &unkeyed(built.err().expect("a failed build")))
+            }));
         }
     };
     Ok(SceneHandle {
