@@ -131,11 +131,13 @@ pub fn build_scene(
     let failed = slot.take();
     let scene = match (built, failed) {
         (Ok(scene), None) => scene,
-        (built, failed) => {
+        (_, Some(failure)) => {
             law::unregister(&keys);
-            return Err(failed.unwrap_or_else(|| {
-                scene_error(py, &unkeyed(built.err().expect("a failed build")))
-            }));
+            return Err(failure);
+        }
+        (Err(e), None) => {
+            law::unregister(&keys);
+            return Err(scene_error(py, &unkeyed(e)));
         }
     };
     Ok(SceneHandle {
