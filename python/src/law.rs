@@ -44,6 +44,59 @@ impl FailureSlot {
 pub struct Registered {
     pub callable: Py<PyAny>,
     pub slot: Arc<FailureSlot>,
+    /// One sample may be passed as three floats (see [`takes_floats`]).
+    pub floats: bool,
+}
+
+/// Whether `law` gives, called with three floats, bit for bit what it gives for arrays of
+/// one sample. Then the time-domain reference and the Floquet analysis, which evaluate one
+/// sample at a time, call it with floats: numpy's arithmetic on a number costs a tenth of
+/// that on an array. A law that needs arrays (`len(u)`, `u.shape`) keeps arrays.
+pub fn takes_floats(py: Python<'_>, law: &Bound<'_, PyAny>) -> bool {
+    let points = [(0.0, 1e-3, 1e-2), (2.0, -0.3, 0.5), (4.0, 1.7, -2.0)];
+    points.iter().all(|&(t, u, du)| {
+        let with_floats = law
+            .call1((t, u, du))
+            .ok()
+            .and_then(|r| three(py, &r, 1).ok());
+        let with_arrays = law
+            .call1((
+                PyArray1::from_slice(py, &[t]),
+                PyArray1::from_slice(py, &[u]),
+                PyArray1::from_slice(py, &[du]),
+            ))
+            .ok()
+            .and_then(|r| three(py, &r, 1).ok());
+        match (with_floats, with_arrays) {
+            (Some(a), Some(b)) => (0..3).all(|j| a[j][0].to_bits() == b[j][0].to_bits()),
+            _ => false,
+        }
+    })
+}
+
+/// The three parts `(f, df_du, df_ddu)` of a law's return value, each of `n` samples.
+fn three(py: Python<'_>, returned: &Bound<'_, PyAny>, n: usize) -> Result<[Vec<f64>; 3], String> {
+    let parts: Vec<Bound<'_, PyAny>> = returned
+        .try_iter()
+        .and_then(|it| it.collect::<PyResult<Vec<_>>>())
+        .ok()
+        .filter(|p| p.len() == 3)
+        .ok_or_else(|| {
+            format!(
+                "must return three values (f, df_du, df_ddu), got {}",
+                returned
+                    .get_type()
+                    .name()
+                    .map(|n| n.to_string())
+                    .unwrap_or_default()
+            )
+        })?;
+    let what = ["f", "df_du", "df_ddu"];
+    let mut output: [Vec<f64>; 3] = Default::default();
+    for (j, part) in parts.iter().enumerate() {
+        output[j] = samples(py, part, n).map_err(|reason| format!("{} {reason}", what[j]))?;
+    }
+    Ok(output)
 }
 
 /// Laws by registry key (`name#n`, unique per scene handle): the scene documents given to
@@ -173,37 +226,25 @@ impl PythonLaw {
         du: &[f64],
     ) -> PyResult<[Vec<f64>; 3]> {
         let name = user_name(&self.key);
-        let args = (
-            PyArray1::from_slice(py, theta),
-            PyArray1::from_slice(py, u),
-            PyArray1::from_slice(py, du),
-        );
-        let returned = self.law.callable.bind(py).call1(args).map_err(|e| {
+        let callable = self.law.callable.bind(py);
+        let returned = if theta.len() == 1 && self.law.floats {
+            callable.call1((theta[0], u[0], du[0]))
+        } else {
+            callable.call1((
+                PyArray1::from_slice(py, theta),
+                PyArray1::from_slice(py, u),
+                PyArray1::from_slice(py, du),
+            ))
+        };
+        let returned = returned.map_err(|e| {
             let err = LawError::new_err(format!("Python law `{name}` raised: {e}"));
             err.set_cause(py, Some(e));
             err
         })?;
-        let parts: Vec<Bound<'_, PyAny>> = returned
-            .try_iter()
-            .and_then(|it| it.collect::<PyResult<Vec<_>>>())
-            .ok()
-            .filter(|p| p.len() == 3)
-            .ok_or_else(|| {
-                LawError::new_err(format!(
-                    "Python law `{name}` must return three values (f, df_du, df_ddu), got {}",
-                    returned
-                        .get_type()
-                        .name()
-                        .map(|n| n.to_string())
-                        .unwrap_or_default()
-                ))
-            })?;
+        let output = three(py, &returned, theta.len())
+            .map_err(|reason| LawError::new_err(format!("Python law `{name}`: {reason}")))?;
         let what = ["f", "df_du", "df_ddu"];
-        let mut output: [Vec<f64>; 3] = Default::default();
-        for (j, part) in parts.iter().enumerate() {
-            output[j] = samples(py, part, theta.len()).map_err(|reason| {
-                LawError::new_err(format!("Python law `{name}`: {} {reason}", what[j]))
-            })?;
+        for j in 0..3 {
             if let Some(i) = output[j].iter().position(|x| !x.is_finite()) {
                 return Err(LawError::new_err(format!(
                     "Python law `{name}`: {} is {} at theta = {}, u = {}, du = {}",

@@ -115,11 +115,13 @@ pub fn build_scene(
                 )));
             }
             let key = format!("{name}#{build}");
+            let floats = law::takes_floats(py, &callable);
             law::register(
                 key.clone(),
                 Registered {
                     callable: callable.unbind(),
                     slot: slot.clone(),
+                    floats,
                 },
             );
             rename_laws(&mut document, &name, &key);
