@@ -13,6 +13,9 @@ springs and force laws of your own, computed in the frequency domain by the Rust
   Python force laws (:mod:`hbal.laws`).
 - :func:`solve`, :func:`sweep`, :func:`parameter_sweep`, :func:`modes`, :func:`compare`:
   the command line's analyses, returning result objects (:mod:`hbal.results`).
+- :mod:`hbal.study` and :mod:`hbal.variants`: many variants through any executor (a process
+  pool, Dask), one tidy table written to Parquet as it goes, resumable;
+  :func:`percentile_bands` and :func:`plot_bands` over it.
 - Errors: :class:`InputError` (bad input, a ``ValueError``), :class:`SceneError` (names
   the field), :class:`LawError` (a Python law), :class:`NumericalError` (a failure after
   the input was checked, a ``RuntimeError``).
@@ -26,7 +29,9 @@ from ._hbal import (
     SceneError,
     __version__,
 )
+from . import study, variants
 from .analyses import compare, modes, parameter_sweep, solve, sweep
+from .bands import percentile_bands, plot_bands
 from .laws import check_law
 from .model import scene_from_matrices
 from .results import (
@@ -61,7 +66,11 @@ __all__ = [
     "compare",
     "modes",
     "parameter_sweep",
+    "percentile_bands",
+    "plot_bands",
     "scene_from_matrices",
     "solve",
+    "study",
     "sweep",
+    "variants",
 ]

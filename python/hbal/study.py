@@ -1,0 +1,249 @@
+"""Studies: many independent analyses of variants of one scene, through any
+``concurrent.futures.Executor`` — a local process pool by default, a Dask client's
+(``client.get_executor()``: a LocalCluster, or dask-jobqueue's Slurm cluster) for many machines.
+
+The result is one tidy table, a row per variant, speed, quantity and order: ``variant``, the
+varied fields (one column per path), ``speed`` (the scene's unit), ``quantity`` (a DOF, or
+``u(element)``/``f(element)``: an element's coordinate, e.g. a gear stage's transmission error,
+or its force), ``order`` (shaft order), ``amplitude``, ``phase`` (rad, of ``c − i s``),
+``stable``, ``error_estimate``, ``status`` (``ok`` or ``failed``) and ``reason``. A variant that
+fails (a field the scene does not have, a law that raises, a solve that does not converge, a
+branch that stops) has a row with ``status == "failed"`` and the reason, never dropped.
+
+With ``out`` the rows are written to Parquet as tasks finish (``part-*.parquet``, each written
+once, atomically): a study that is interrupted resumes where it stopped with the same call,
+and a task a killed worker had started is redone by the executor and written once.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import hashlib
+import json
+import os
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+
+from . import _hbal
+from .analyses import solve, sweep
+from .scene import Scene
+
+COLUMNS = ["speed", "quantity", "order", "amplitude", "phase", "stable", "error_estimate", "status", "reason"]
+
+
+def run(
+    scene: Scene,
+    variants: Sequence[Mapping[str, float]],
+    *,
+    speeds: Sequence[float] | None = None,
+    sweep_to: float | None = None,
+    sweep_from: float | None = None,
+    quantities: Sequence[str] | None = None,
+    orders: Sequence[float] | None = None,
+    options: Mapping[str, Any] | None = None,
+    out: str | os.PathLike | None = None,
+    executor: cf.Executor | None = None,
+    chunk: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+):
+    """Runs every variant and returns the table (a pandas DataFrame).
+
+    Each variant is solved at each of ``speeds`` (independent solves), or swept from
+    ``sweep_from`` (default the scene's speed) to ``sweep_to``. ``quantities`` default to every
+    DOF; ``orders`` to the first ten harmonics' shaft orders. ``options`` go to
+    :func:`hbal.solve` or :func:`hbal.sweep`. ``chunk`` variants make one task (default: about
+    eight tasks per worker of the pool). ``progress(done, total)`` counts variants."""
+    import pandas as pd
+
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene: expected an hbal.Scene, got {type(scene).__name__}")
+    if scene.on_torus:
+        raise _hbal.InputError("studies of scenes on several base frequencies are not supported yet")
+    if (speeds is None) == (sweep_to is None):
+        raise _hbal.InputError("give either speeds (a solve at each) or sweep_to (a sweep per variant)")
+    variants = [dict(v) for v in variants]
+    paths = sorted({p for v in variants for p in v})
+    spec = {
+        "speeds": None if speeds is None else [float(s) for s in speeds],
+        "sweep": None if sweep_to is None else {"to": float(sweep_to), "start": None if sweep_from is None else float(sweep_from)},
+        "quantities": list(quantities) if quantities is not None else list(scene.dofs),
+        "orders": None if orders is None else [float(o) for o in orders],
+        "options": dict(options or {}),
+        "unit": scene.speed_unit,
+        "paths": paths,
+    }
+    _check_quantities(scene, spec)
+    store = _Store(out, scene, variants, spec) if out is not None else None
+    todo = [i for i in range(len(variants)) if store is None or i not in store.done]
+    own = executor is None
+    if own:
+        executor = cf.ProcessPoolExecutor()
+    workers = getattr(executor, "_max_workers", None) or os.cpu_count() or 1
+    chunk = chunk or max(1, min(50, len(todo) // (8 * workers) or 1))
+    payload = (scene.to_json(indent=None), scene.file, scene.laws, spec)
+    rows: list[dict] = []
+    done = len(variants) - len(todo)
+    futures = {}
+    try:
+        for start in range(0, len(todo), chunk):
+            items = [(i, variants[i]) for i in todo[start : start + chunk]]
+            futures[executor.submit(run_chunk, payload, items)] = items
+        if progress:
+            progress(done, len(variants))
+        for f in cf.as_completed(futures):
+            chunk_rows = f.result()
+            if store is not None:
+                store.write(futures[f], chunk_rows)
+            else:
+                rows.extend(chunk_rows)
+            done += len(futures[f])
+            if progress:
+                progress(done, len(variants))
+    except BaseException:
+        for f in futures:
+            f.cancel()
+        raise
+    finally:
+        if own:
+            executor.shutdown(wait=True, cancel_futures=True)
+    table = store.table() if store is not None else _frame(rows, paths)
+    return table
+
+
+def load(out: str | os.PathLike):
+    """The table of a study written to ``out`` (complete or not)."""
+    import pandas as pd
+
+    parts = sorted(p for p in os.listdir(out) if p.startswith("part-") and p.endswith(".parquet"))
+    frames = [pd.read_parquet(os.path.join(out, p)) for p in parts]
+    if not frames:
+        return pd.DataFrame(columns=["variant", *COLUMNS])
+    return _sorted(pd.concat(frames, ignore_index=True))
+
+
+def _sorted(table):
+    return table.sort_values(["variant", "speed", "quantity", "order"], kind="stable", na_position="first").reset_index(drop=True)
+
+
+def _frame(rows: list[dict], paths: Sequence[str]):
+    import pandas as pd
+
+    table = pd.DataFrame(rows, columns=["variant", *paths, *COLUMNS])
+    table["variant"] = table["variant"].astype("int64")
+    for c in (*paths, "speed", "order", "amplitude", "phase", "error_estimate"):
+        table[c] = table[c].astype("float64")
+    table["stable"] = table["stable"].astype("boolean")
+    for c in ("quantity", "status", "reason"):
+        table[c] = table[c].astype("string")
+    return _sorted(table)
+
+
+def _check_quantities(scene: Scene, spec: dict) -> None:
+    dofs, elements = set(scene.dofs), set(scene.elements)
+    for q in spec["quantities"]:
+        element = q[2:-1] if q[:2] in ("u(", "f(") and q.endswith(")") else None
+        if q in dofs or (element in elements and spec["sweep"] is None):
+            continue
+        what = "a DOF" if spec["sweep"] is not None else "a DOF, u(element) or f(element)"
+        raise _hbal.InputError(f"quantities: `{q}` is not {what} of the scene (DOFs: {sorted(dofs)})")
+
+
+class _Store:
+    """The study's directory: its settings (``study.json``) and one Parquet part per task."""
+
+    def __init__(self, out, scene: Scene, variants: list[dict], spec: dict) -> None:
+        self.out = os.fspath(out)
+        self.paths = spec["paths"]
+        os.makedirs(self.out, exist_ok=True)
+        settings = {"scene": scene.to_dict(), "variants": variants, "spec": {**spec, "options": repr(spec["options"])}}
+        digest = hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()
+        meta = os.path.join(self.out, "study.json")
+        if os.path.exists(meta):
+            with open(meta, encoding="utf-8") as f:
+                if json.load(f).get("digest") != digest:
+                    raise _hbal.InputError(
+                        f"out: {self.out} holds a study of another scene, variants or settings; choose another directory or remove it"
+                    )
+        else:
+            with open(meta, "w", encoding="utf-8") as f:
+                json.dump({"digest": digest, "variants": len(variants), "paths": self.paths}, f)
+        self.done = set(load(self.out)["variant"].astype(int).tolist())
+
+    def write(self, items, rows: list[dict]) -> None:
+        ids = [i for i, _ in items]
+        name = f"part-{min(ids):07d}-{max(ids):07d}"
+        tmp = os.path.join(self.out, f".{name}.tmp")
+        _frame(rows, self.paths).to_parquet(tmp, index=False)
+        os.replace(tmp, os.path.join(self.out, name + ".parquet"))
+
+    def table(self):
+        return load(self.out)
+
+
+def run_chunk(payload, items) -> list[dict]:
+    """A task: the rows of the variants ``items`` (pairs of index and fields)."""
+    text, file, laws, spec = payload
+    base = Scene(json.loads(text), file=file, laws=laws)
+    rows = []
+    for index, fields in items:
+        rows.extend(_variant_rows(base, index, fields, spec))
+    return rows
+
+
+def _failure(index, fields, speed, reason) -> dict:
+    return {"variant": index, **fields, "speed": speed, "quantity": None, "order": np.nan, "amplitude": np.nan,
+            "phase": np.nan, "stable": None, "error_estimate": np.nan, "status": "failed", "reason": reason}
+
+
+def _variant_rows(base: Scene, index: int, fields: dict, spec: dict) -> list[dict]:
+    try:
+        scene = base.with_parameters(fields)
+    except (_hbal.InputError, KeyError, TypeError, ValueError) as e:
+        return [_failure(index, fields, np.nan, f"{type(e).__name__}: {e}")]
+    rows: list[dict] = []
+    if spec["sweep"] is not None:
+        try:
+            branch = sweep(scene, spec["sweep"]["to"], start=spec["sweep"]["start"], **spec["options"])
+        except (_hbal.InputError, _hbal.NumericalError) as e:
+            return [_failure(index, fields, np.nan, f"{type(e).__name__}: {e}")]
+        dofs = branch.record["harmonics_dofs"]
+        for p in branch.points:
+            entries = {d: h for d, h in zip(dofs, p["harmonics"])}
+            rows += _rows(index, fields, p["speed"], entries, spec, p["stable"], p["error_estimate"])
+        if not branch.ok:
+            rows.append(_failure(index, fields, np.nan, f"branch: {branch.stop}"))
+        return rows
+    for speed in spec["speeds"]:
+        try:
+            at = scene.with_parameter(f"fundamental.{spec['unit']}", speed)
+            r = solve(at, **spec["options"])
+        except (_hbal.InputError, _hbal.NumericalError) as e:
+            rows.append(_failure(index, fields, speed, f"{type(e).__name__}: {e}"))
+            continue
+        if not r.converged:
+            rows.append(_failure(index, fields, speed, f"not converged: {r.termination}"))
+            continue
+        entries = {d["name"]: d["harmonics"] for d in r.record["dofs"]}
+        for e in r.record["elements"] if isinstance(r.record["elements"], list) else []:
+            entries[f"u({e['name']})"] = e["coordinate"]["harmonics"]
+            entries[f"f({e['name']})"] = e["force"]["harmonics"]
+        rows += _rows(index, fields, speed, entries, spec, r.stable, r.error_estimate)
+    return rows
+
+
+def _rows(index, fields, speed, entries, spec, stable, error_estimate) -> list[dict]:
+    rows = []
+    for q in spec["quantities"]:
+        for h in entries[q]:
+            if spec["orders"] is None:
+                keep = 1 <= h["harmonic"] <= 10
+            else:
+                keep = any(abs(h["shaft_order"] - o) < 1e-9 * max(1.0, abs(o)) for o in spec["orders"])
+            if keep:
+                z = h["cos"] - 1j * h["sin"]
+                rows.append({"variant": index, **fields, "speed": speed, "quantity": q, "order": h["shaft_order"],
+                             "amplitude": abs(z), "phase": float(np.angle(z)), "stable": stable,
+                             "error_estimate": np.nan if error_estimate is None else error_estimate,
+                             "status": "ok", "reason": ""})
+    return rows
