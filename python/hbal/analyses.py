@@ -50,7 +50,7 @@ def solve(
     (``hbal solve``). ``harmonics`` is H or ``"auto"``, ``"auto:harmonics"``, ...;
     ``stability=False`` is ``--no-stability``, ``fallback=False`` ``--no-fallback``."""
     s = _scene(scene)
-    record, code = _hbal.solve(
+    record, code, seconds = _hbal.solve(
         s._handle,
         method=method,
         harmonics=harmonics,
@@ -60,7 +60,7 @@ def solve(
         stability=stability,
         fallback=fallback,
     )
-    return (TorusSolveResult if s.on_torus else SolveResult)(record, code)
+    return (TorusSolveResult if s.on_torus else SolveResult)(record, code, seconds)
 
 
 def sweep(
@@ -90,7 +90,7 @@ def sweep(
     s = _scene(scene)
     if dofs is not None and not isinstance(dofs, str):
         dofs = ",".join(dofs)
-    record, code = _hbal.sweep(
+    record, code, seconds = _hbal.sweep(
         s._handle,
         float(to),
         start=None if start is None else float(start),
@@ -109,7 +109,7 @@ def sweep(
         dofs=dofs,
         progress=progress,
     )
-    return (TorusSweepResult if s.on_torus else SweepResult)(record, code)
+    return (TorusSweepResult if s.on_torus else SweepResult)(record, code, seconds)
 
 
 def parameter_sweep(
@@ -131,7 +131,7 @@ def parameter_sweep(
     s = _scene(scene)
     if dofs is not None and not isinstance(dofs, str):
         dofs = ",".join(dofs)
-    record, code = _hbal.parameter_sweep(
+    record, code, seconds = _hbal.parameter_sweep(
         s._handle,
         parameter,
         float(start),
@@ -144,7 +144,7 @@ def parameter_sweep(
         dofs=dofs,
         progress=progress,
     )
-    return ParameterSweepResult(record, code)
+    return ParameterSweepResult(record, code, seconds)
 
 
 def modes(
@@ -158,8 +158,8 @@ def modes(
     """Natural frequencies and mode shapes about the periodic solution and the critical
     speeds between ``start`` and ``to`` (``hbal modes``)."""
     s = _scene(scene)
-    record, code = _hbal.modes(s._handle, start=start, to=to, max_hz=max_hz, formulation=formulation)
-    return ModesResult(record, code)
+    record, code, seconds = _hbal.modes(s._handle, start=start, to=to, max_hz=max_hz, formulation=formulation)
+    return ModesResult(record, code, seconds)
 
 
 def compare(
@@ -174,7 +174,7 @@ def compare(
     """Every solver (or ``methods``) and the time-domain reference, with their errors
     (``hbal compare``)."""
     s = _scene(scene)
-    record, code = _hbal.compare(
+    record, code, seconds = _hbal.compare(
         s._handle,
         methods=None if methods is None else list(methods),
         harmonics=harmonics,
@@ -182,4 +182,4 @@ def compare(
         tolerance=tolerance,
         formulation=formulation,
     )
-    return CompareResult(record, code)
+    return CompareResult(record, code, seconds)

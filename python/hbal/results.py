@@ -21,9 +21,19 @@ import numpy as np
 class Result:
     """An analysis's record and exit code."""
 
-    def __init__(self, record: dict, exit_code: int) -> None:
-        self.record = record
+    def __init__(self, record, exit_code: int, library_seconds: float | None = None) -> None:
+        # A dict, or the library's record not yet converted (built when first read).
+        self._record = record
         self.exit_code = int(exit_code)
+        #: The wall time of the Rust library's call alone (None for a result read back).
+        self.library_seconds = library_seconds
+
+    @property
+    def record(self) -> dict:
+        """The analysis's record: what ``hbal ... --json`` prints, as Python objects."""
+        if not isinstance(self._record, dict):
+            self._record = self._record.to_python()
+        return self._record
 
     @property
     def ok(self) -> bool:

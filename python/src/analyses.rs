@@ -1,37 +1,47 @@
 //! The analyses of `hbal.solve`, `hbal.sweep`, `hbal.parameter_sweep`, `hbal.modes` and
 //! `hbal.compare`: the library's `hbal::analysis` functions with the command line's options,
-//! run with the GIL released. Each returns `(record, exit_code)`: the analysis's serde form
-//! (what `hbal ... --json` prints, as Python objects, bit for bit) and the exit code of the
-//! command-line contract (0, or 1 where the result is marked).
+//! run with the GIL released. Each returns `(record, exit_code, seconds)`: the analysis's serde form
+//! (what `hbal ... --json` prints, as Python objects, bit for bit, built when first read) and the exit code of the
+//! command-line contract (0, or 1 where the result is marked) and the library call's wall time.
 
 use crate::errors::InputError;
 use crate::progress::PyProgress;
+use crate::record::{Record, ToRecord};
 use crate::scene::{error, SceneHandle};
-use crate::value::to_python;
 use hbal::analysis as an;
 use hbal::scene::{HarmonicsOverride, Overrides};
 use hbal::Formulation;
 use pyo3::prelude::*;
-use serde::Serialize;
 
 /// The most points of a sweep (as `--points`, `--max-points` of the command line).
 const MAX_SWEEP_POINTS: usize = 100_000;
 
+/// What an analysis returns to Python: its record, its exit code and the wall time of the
+/// library's call alone (s; what the binding adds around it is the rest of the Python call).
+type Returned<'py> = (Bound<'py, Record>, u8, f64);
+
+/// Runs `analysis` with the GIL released, timing it.
+fn timed<T: Send>(py: Python<'_>, analysis: impl FnOnce() -> T + Send) -> (T, f64) {
+    py.detach(|| {
+        let start = std::time::Instant::now();
+        let result = analysis();
+        (result, start.elapsed().as_secs_f64())
+    })
+}
+
 /// The record and exit code of an analysis, or its error (a Python law's failure first).
-fn finish<'py, T: Serialize>(
+fn finish<'py, T: ToRecord + 'static>(
     py: Python<'py>,
     handle: &SceneHandle,
-    result: hbal::Result<T>,
+    (result, seconds): (hbal::Result<T>, f64),
     exit_code: impl FnOnce(&T) -> u8,
-) -> PyResult<(Bound<'py, PyAny>, u8)> {
+) -> PyResult<Returned<'py>> {
     if let Some(e) = handle.law_failure() {
         return Err(e);
     }
     let analysis = result.map_err(|e| error(py, handle, e))?;
     let code = exit_code(&analysis);
-    let value = serde_json::to_value(&analysis)
-        .map_err(|e| crate::errors::NumericalError::new_err(e.to_string()))?;
-    Ok((to_python(py, &value)?, code))
+    Ok((Bound::new(py, Record::new(analysis))?, code, seconds))
 }
 
 fn invalid(option: &str, reason: impl std::fmt::Display) -> PyErr {
@@ -94,7 +104,7 @@ pub fn solve<'py>(
     formulation: Option<&str>,
     stability: bool,
     fallback: bool,
-) -> PyResult<(Bound<'py, PyAny>, u8)> {
+) -> PyResult<Returned<'py>> {
     let handle = scene.get();
     let o = overrides(method, harmonics, samples, tolerance, formulation)?;
     let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
@@ -105,7 +115,7 @@ pub fn solve<'py>(
             return Err(invalid(name, "applies to one fundamental"));
         }
         let settings = an::TorusSolveSettings { speed: None };
-        let result = py.detach(|| an::torus_solve(s, &settings));
+        let result = timed(py, || an::torus_solve(s, &settings));
         return finish(py, handle, result, |a| a.exit_code());
     }
     let settings = an::SolveSettings {
@@ -114,7 +124,7 @@ pub fn solve<'py>(
         fallback,
         formulation: o.formulation,
     };
-    let result = py.detach(|| an::solve(s, &settings));
+    let result = timed(py, || an::solve(s, &settings));
     finish(py, handle, result, |a| a.exit_code())
 }
 
@@ -144,7 +154,7 @@ pub fn sweep<'py>(
     output: Option<String>,
     dofs: Option<String>,
     progress: Option<Py<PyAny>>,
-) -> PyResult<(Bound<'py, PyAny>, u8)> {
+) -> PyResult<Returned<'py>> {
     let handle = scene.get();
     // The sweep's tolerance is its corrector's; the scene's solver is not used.
     let o = overrides(None, harmonics, samples, None, formulation)?;
@@ -171,7 +181,7 @@ pub fn sweep<'py>(
             to,
             points,
         };
-        let result = py.detach(|| an::torus_sweep(s, &settings, &mut observer));
+        let result = timed(py, || an::torus_sweep(s, &settings, &mut observer));
         observer.raise()?;
         return finish(py, handle, result, |a| a.exit_code());
     }
@@ -192,7 +202,7 @@ pub fn sweep<'py>(
         ..an::SweepSettings::to(to)
     };
     an::check_sweep(s, &settings).map_err(|e| error(py, handle, e))?;
-    let result = py.detach(|| an::sweep(s, &settings, &mut observer));
+    let result = timed(py, || an::sweep(s, &settings, &mut observer));
     observer.raise()?;
     finish(py, handle, result, |a| a.exit_code())
 }
@@ -215,7 +225,7 @@ pub fn parameter_sweep<'py>(
     stability: bool,
     dofs: Option<String>,
     progress: Option<Py<PyAny>>,
-) -> PyResult<(Bound<'py, PyAny>, u8)> {
+) -> PyResult<Returned<'py>> {
     let handle = scene.get();
     let mut observer = PyProgress::new(progress);
     let settings = an::ParameterSweepSettings {
@@ -230,7 +240,9 @@ pub fn parameter_sweep<'py>(
     };
     let (doc, file) = (&handle.document, handle.file.as_str());
     an::check_parameter_sweep(doc, file, &settings).map_err(|e| error(py, handle, e))?;
-    let result = py.detach(|| an::parameter_sweep(doc, file, &settings, &mut observer));
+    let result = timed(py, || {
+        an::parameter_sweep(doc, file, &settings, &mut observer)
+    });
     observer.raise()?;
     finish(py, handle, result, |a| a.exit_code())
 }
@@ -246,7 +258,7 @@ pub fn modes<'py>(
     to: Option<f64>,
     max_hz: Option<f64>,
     formulation: Option<&str>,
-) -> PyResult<(Bound<'py, PyAny>, u8)> {
+) -> PyResult<Returned<'py>> {
     let handle = scene.get();
     let settings = an::ModesSettings {
         from: start,
@@ -255,7 +267,7 @@ pub fn modes<'py>(
         formulation: formulation_of(formulation)?,
     };
     let s = &handle.scene;
-    let result = py.detach(|| an::modes(s, &settings));
+    let result = timed(py, || an::modes(s, &settings));
     finish(py, handle, result, |_| 0)
 }
 
@@ -272,7 +284,7 @@ pub fn compare<'py>(
     samples: Option<usize>,
     tolerance: Option<f64>,
     formulation: Option<&str>,
-) -> PyResult<(Bound<'py, PyAny>, u8)> {
+) -> PyResult<Returned<'py>> {
     let handle = scene.get();
     let o = overrides(None, harmonics, samples, None, formulation)?;
     let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
@@ -282,7 +294,7 @@ pub fn compare<'py>(
         tolerance,
         formulation: o.formulation,
     };
-    let result = py.detach(|| an::compare(s, &settings));
+    let result = timed(py, || an::compare(s, &settings));
     finish(py, handle, result, |a| a.exit_code())
 }
 

@@ -9,6 +9,7 @@ mod analyses;
 mod errors;
 mod law;
 mod progress;
+mod record;
 mod scene;
 mod value;
 
@@ -18,6 +19,7 @@ use pyo3::prelude::*;
 fn _hbal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     m.add_class::<scene::SceneHandle>()?;
+    m.add_class::<record::Record>()?;
     m.add_function(wrap_pyfunction!(scene::build_scene, m)?)?;
     m.add_function(wrap_pyfunction!(scene::parse_scene, m)?)?;
     m.add_function(wrap_pyfunction!(scene::read_scene, m)?)?;

@@ -35,7 +35,7 @@ impl SceneHandle {
     /// The scene with `overrides` applied: the built one where there are none, else a new
     /// build of the document.
     pub fn with(&self, overrides: &Overrides) -> hbal::Result<Built<'_>> {
-        if *overrides == Overrides::default() {
+        if *overrides == command_line_defaults() {
             return Ok(Built::Shared(&self.scene));
         }
         let mut scene = Scene::from_value(self.document.clone(), &self.file)?;
@@ -71,6 +71,15 @@ impl SceneHandle {
             "notes": s.notes,
         });
         to_python(py, &info)
+    }
+}
+
+/// The overrides the command line applies when none is given (`--formulation auto`): the
+/// built scene has them, so that an analysis without options reuses it.
+fn command_line_defaults() -> Overrides {
+    Overrides {
+        formulation: hbal::Formulation::Auto,
+        ..Overrides::default()
     }
 }
 
@@ -132,7 +141,12 @@ pub fn build_scene(
     let built = Scene::from_value(document.clone(), file);
     let failed = slot.take();
     let scene = match (built, failed) {
-        (Ok(scene), None) => scene,
+        (Ok(mut scene), None) => {
+            command_line_defaults()
+                .apply(&mut scene)
+                .map_err(|e| crate::errors::to_py(py, e))?;
+            scene
+        }
         (_, Some(failure)) => {
             law::unregister(&keys);
             return Err(failure);

@@ -1,0 +1,69 @@
+//! An analysis's record, made when Python first reads it: [`Record`] holds the library's
+//! typed result and builds its serde form (what `hbal ... --json` prints) on the first
+//! `to_python()`. A solve returns at once; what is read pays for the conversion.
+
+use crate::value::to_python;
+use hbal::analysis as an;
+use pyo3::prelude::*;
+use serde_json::Value;
+use std::sync::Mutex;
+
+/// An analysis whose JSON record can be built.
+pub trait ToRecord: Send + Sync {
+    fn record(&self) -> Value;
+}
+
+macro_rules! by_to_json {
+    ($($t:ty),*) => {$(
+        impl ToRecord for $t {
+            fn record(&self) -> Value {
+                self.to_json()
+            }
+        }
+    )*};
+}
+by_to_json!(
+    an::SolveAnalysis,
+    an::SweepAnalysis,
+    an::ParameterSweepAnalysis,
+    an::ModesAnalysis,
+    an::CompareAnalysis
+);
+
+macro_rules! by_serde {
+    ($($t:ty),*) => {$(
+        impl ToRecord for $t {
+            fn record(&self) -> Value {
+                serde_json::to_value(self).unwrap_or_else(|e| serde_json::json!({ "error": e.to_string() }))
+            }
+        }
+    )*};
+}
+by_serde!(an::TorusSolveAnalysis, an::TorusSweepAnalysis);
+
+/// The record of one analysis.
+#[pyclass(frozen, module = "hbal._hbal")]
+pub struct Record(Mutex<Option<Box<dyn ToRecord>>>);
+
+impl Record {
+    pub fn new(analysis: impl ToRecord + 'static) -> Self {
+        Record(Mutex::new(Some(Box::new(analysis))))
+    }
+}
+
+#[pymethods]
+impl Record {
+    /// The record as Python objects (once: the analysis is dropped then).
+    fn to_python<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let analysis = self
+            .0
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .take()
+            .ok_or_else(|| {
+                pyo3::exceptions::PyRuntimeError::new_err("the record was read already")
+            })?;
+        let value = py.detach(|| analysis.record());
+        to_python(py, &value)
+    }
+}
