@@ -198,6 +198,13 @@ def _restore(text: str, file: str, laws: Mapping[str, Callable]) -> Scene:
 
 def _plain(obj: Any) -> Any:
     """``obj`` with numpy arrays and scalars, tuples and mappings as plain Python values."""
+    kind = type(obj)
+    if kind is float or kind is str or kind is int or kind is bool or obj is None:
+        return obj
+    if kind is dict:
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if kind is list:
+        return [_plain(v) for v in obj]
     if isinstance(obj, Mapping):
         return {str(k): _plain(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):

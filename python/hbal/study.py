@@ -82,7 +82,7 @@ def run(
     workers = getattr(executor, "_max_workers", None) or os.cpu_count() or 1
     chunk = chunk or max(1, min(50, len(todo) // (8 * workers) or 1))
     payload = (scene.to_json(indent=None), scene.file, scene.laws, spec)
-    rows: list[dict] = []
+    rows: list[tuple] = []
     done = len(variants) - len(todo)
     futures = {}
     try:
@@ -126,10 +126,10 @@ def _sorted(table):
     return table.sort_values(["variant", "speed", "quantity", "order"], kind="stable", na_position="first").reset_index(drop=True)
 
 
-def _frame(rows: list[dict], paths: Sequence[str]):
+def _frame(rows: list[tuple], paths: Sequence[str]):
     import pandas as pd
 
-    table = pd.DataFrame(rows, columns=["variant", *paths, *COLUMNS])
+    table = pd.DataFrame.from_records(rows, columns=["variant", *paths, *COLUMNS])
     table["variant"] = table["variant"].astype("int64")
     for c in (*paths, "speed", "order", "amplitude", "phase", "error_estimate"):
         table[c] = table[c].astype("float64")
@@ -170,7 +170,7 @@ class _Store:
                 json.dump({"digest": digest, "variants": len(variants), "paths": self.paths}, f)
         self.done = set(load(self.out)["variant"].astype(int).tolist())
 
-    def write(self, items, rows: list[dict]) -> None:
+    def write(self, items, rows: list[tuple]) -> None:
         ids = [i for i, _ in items]
         name = f"part-{min(ids):07d}-{max(ids):07d}"
         tmp = os.path.join(self.out, f".{name}.tmp")
@@ -181,8 +181,9 @@ class _Store:
         return load(self.out)
 
 
-def run_chunk(payload, items) -> list[dict]:
-    """A task: the rows of the variants ``items`` (pairs of index and fields)."""
+def run_chunk(payload, items) -> list[tuple]:
+    """A task: the rows of the variants ``items`` (pairs of index and fields), as tuples in the
+    table's column order (light to ship back)."""
     text, file, laws, spec = payload
     base = Scene(json.loads(text), file=file, laws=laws)
     rows = []
@@ -191,38 +192,41 @@ def run_chunk(payload, items) -> list[dict]:
     return rows
 
 
-def _failure(index, fields, speed, reason) -> dict:
-    return {"variant": index, **fields, "speed": speed, "quantity": None, "order": np.nan, "amplitude": np.nan,
-            "phase": np.nan, "stable": None, "error_estimate": np.nan, "status": "failed", "reason": reason}
+def _head(index, fields, spec) -> tuple:
+    return (index, *(float(fields.get(p, np.nan)) for p in spec["paths"]))
 
 
-def _variant_rows(base: Scene, index: int, fields: dict, spec: dict) -> list[dict]:
+def _failure(index, fields, speed, reason, spec) -> tuple:
+    return (*_head(index, fields, spec), speed, None, np.nan, np.nan, np.nan, None, np.nan, "failed", reason)
+
+
+def _variant_rows(base: Scene, index: int, fields: dict, spec: dict) -> list[tuple]:
     try:
         scene = base.with_parameters(fields)
     except (_hbal.InputError, KeyError, TypeError, ValueError) as e:
-        return [_failure(index, fields, np.nan, f"{type(e).__name__}: {e}")]
-    rows: list[dict] = []
+        return [_failure(index, fields, np.nan, f"{type(e).__name__}: {e}", spec)]
+    rows: list[tuple] = []
     if spec["sweep"] is not None:
         try:
             branch = sweep(scene, spec["sweep"]["to"], start=spec["sweep"]["start"], **spec["options"])
         except (_hbal.InputError, _hbal.NumericalError) as e:
-            return [_failure(index, fields, np.nan, f"{type(e).__name__}: {e}")]
+            return [_failure(index, fields, np.nan, f"{type(e).__name__}: {e}", spec)]
         dofs = branch.record["harmonics_dofs"]
         for p in branch.points:
             entries = {d: h for d, h in zip(dofs, p["harmonics"])}
             rows += _rows(index, fields, p["speed"], entries, spec, p["stable"], p["error_estimate"])
         if not branch.ok:
-            rows.append(_failure(index, fields, np.nan, f"branch: {branch.stop}"))
+            rows.append(_failure(index, fields, np.nan, f"branch: {branch.stop}", spec))
         return rows
     for speed in spec["speeds"]:
         try:
             at = scene.with_parameter(f"fundamental.{spec['unit']}", speed)
             r = solve(at, **spec["options"])
         except (_hbal.InputError, _hbal.NumericalError) as e:
-            rows.append(_failure(index, fields, speed, f"{type(e).__name__}: {e}"))
+            rows.append(_failure(index, fields, speed, f"{type(e).__name__}: {e}", spec))
             continue
         if not r.converged:
-            rows.append(_failure(index, fields, speed, f"not converged: {r.termination}"))
+            rows.append(_failure(index, fields, speed, f"not converged: {r.termination}", spec))
             continue
         entries = {d["name"]: d["harmonics"] for d in r.record["dofs"]}
         for e in r.record["elements"] if isinstance(r.record["elements"], list) else []:
@@ -232,18 +236,18 @@ def _variant_rows(base: Scene, index: int, fields: dict, spec: dict) -> list[dic
     return rows
 
 
-def _rows(index, fields, speed, entries, spec, stable, error_estimate) -> list[dict]:
+def _rows(index, fields, speed, entries, spec, stable, error_estimate) -> list[tuple]:
     rows = []
+    head = _head(index, fields, spec)
+    estimate = np.nan if error_estimate is None else error_estimate
+    wanted = None if spec["orders"] is None else {round(o, 9) for o in spec["orders"]}
     for q in spec["quantities"]:
         for h in entries[q]:
-            if spec["orders"] is None:
+            if wanted is None:
                 keep = 1 <= h["harmonic"] <= 10
             else:
-                keep = any(abs(h["shaft_order"] - o) < 1e-9 * max(1.0, abs(o)) for o in spec["orders"])
+                keep = round(h["shaft_order"], 9) in wanted
             if keep:
-                z = h["cos"] - 1j * h["sin"]
-                rows.append({"variant": index, **fields, "speed": speed, "quantity": q, "order": h["shaft_order"],
-                             "amplitude": abs(z), "phase": float(np.angle(z)), "stable": stable,
-                             "error_estimate": np.nan if error_estimate is None else error_estimate,
-                             "status": "ok", "reason": ""})
+                z = complex(h["cos"], -h["sin"])
+                rows.append((*head, speed, q, h["shaft_order"], abs(z), float(np.angle(z)), stable, estimate, "ok", ""))
     return rows
