@@ -149,8 +149,10 @@ class Scene:
 
     @property
     def speed(self) -> float:
-        """The scene's speed, in :attr:`speed_unit`."""
-        return self._info["speed"]
+        """The scene's speed, in :attr:`speed_unit` (as the scene gives it)."""
+        given = self._document.get("fundamental", {})
+        value = given.get(self.speed_unit) if isinstance(given, dict) else None
+        return float(value) if isinstance(value, (int, float)) else self._info["speed"]
 
     @property
     def speed_unit(self) -> str:
