@@ -61,7 +61,9 @@ def overhead(rows):
 
 
 def duffing(theta, u, du):
-    return u + u**3, 1.0 + 3.0 * u**2, 0.0
+    """f = u + u³ (u * u rather than u**2: numpy's power is several times slower)."""
+    u2 = u * u
+    return u + u2 * u, 1.0 + 3.0 * u2, 0.0
 
 
 def python_law(rows):

@@ -302,5 +302,8 @@ pub fn compare<'py>(
 #[pyfunction]
 pub fn check(py: Python<'_>, scene: &Bound<'_, SceneHandle>) -> PyResult<()> {
     let handle = scene.get();
-    an::check(&handle.scene).map_err(|e| error(py, handle, e))
+    let s = &handle.scene;
+    py.detach(|| an::check(s))
+        .map_err(|e| error(py, handle, e))?;
+    handle.law_failure().map_or(Ok(()), Err)
 }

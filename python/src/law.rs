@@ -17,7 +17,7 @@
 use crate::errors::LawError;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyFloat;
+use pyo3::types::{PyFloat, PyTuple};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -190,31 +190,72 @@ impl serde::Serialize for PythonLaw {
 
 impl PythonLaw {
     /// f, ∂f/∂u, ∂f/∂u̇ at the samples, into `out` (NaN and the failure recorded on error).
+    ///
+    /// The GIL is taken before the cache's lock, on every thread: a thread waiting for the
+    /// lock never holds the GIL another thread needs to release the lock.
     fn evaluate(&self, theta: &[f64], u: &[f64], du: &[f64], want: Want, out: Out<'_>) {
-        let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
-        let same = last.input[0] == theta && last.input[1] == u && last.input[2] == du;
-        if !same {
-            let result = Python::attach(|py| self.call(py, theta, u, du));
-            match result {
-                Ok(output) => {
-                    last.input = [theta.to_vec(), u.to_vec(), du.to_vec()];
-                    last.output = output;
-                }
-                Err(e) => {
+        crate::thread_state::keep();
+        Python::attach(|py| {
+            let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
+            let same = last.input[0] == theta && last.input[1] == u && last.input[2] == du;
+            if !same {
+                let called = if theta.len() == 1 && self.law.floats {
+                    self.call_floats(py, theta[0], u[0], du[0], &mut last.output)
+                } else {
+                    self.call(py, theta, u, du)
+                        .map(|output| last.output = output)
+                };
+                if let Err(e) = called {
                     last.input = Default::default();
                     self.law.slot.record(e);
                     out.fill(f64::NAN);
                     return;
                 }
+                for (kept, given) in last.input.iter_mut().zip([theta, u, du]) {
+                    kept.clear();
+                    kept.extend_from_slice(given);
+                }
+            }
+            match want {
+                Want::Force => out.force.copy_from_slice(&last.output[0]),
+                Want::Derivatives => {
+                    out.dfdu.copy_from_slice(&last.output[1]);
+                    out.dfddu.copy_from_slice(&last.output[2]);
+                }
+            }
+        });
+    }
+
+    /// One sample as floats: the common return of three floats read without allocating,
+    /// anything else by [`PythonLaw::call`]'s checks.
+    fn call_floats(
+        &self,
+        py: Python<'_>,
+        theta: f64,
+        u: f64,
+        du: f64,
+        output: &mut [Vec<f64>; 3],
+    ) -> PyResult<()> {
+        let returned = self.law.callable.bind(py).call1((theta, u, du));
+        if let Ok(Ok(t)) = returned.as_ref().map(|r| r.cast::<PyTuple>()) {
+            if t.len() == 3 {
+                let mut floats = [f64::NAN; 3];
+                for (j, x) in floats.iter_mut().enumerate() {
+                    if let Ok(f) = t.get_item(j).and_then(|p| Ok(p.cast_into::<PyFloat>()?)) {
+                        *x = f.value();
+                    }
+                }
+                if floats.iter().all(|x| x.is_finite()) {
+                    for (o, x) in output.iter_mut().zip(floats) {
+                        o.clear();
+                        o.push(x);
+                    }
+                    return Ok(());
+                }
             }
         }
-        match want {
-            Want::Force => out.force.copy_from_slice(&last.output[0]),
-            Want::Derivatives => {
-                out.dfdu.copy_from_slice(&last.output[1]);
-                out.dfddu.copy_from_slice(&last.output[2]);
-            }
-        }
+        *output = self.checked(py, returned, &[theta], &[u], &[du])?;
+        Ok(())
     }
 
     /// One call of the Python function, its three results checked.
@@ -225,17 +266,25 @@ impl PythonLaw {
         u: &[f64],
         du: &[f64],
     ) -> PyResult<[Vec<f64>; 3]> {
+        let returned = self.law.callable.bind(py).call1((
+            PyArray1::from_slice(py, theta),
+            PyArray1::from_slice(py, u),
+            PyArray1::from_slice(py, du),
+        ));
+        self.checked(py, returned, theta, u, du)
+    }
+
+    /// The three results of a call at the samples `theta`, `u`, `du`, checked: the law's
+    /// exception, or a `LawError` naming what is wrong.
+    fn checked(
+        &self,
+        py: Python<'_>,
+        returned: PyResult<Bound<'_, PyAny>>,
+        theta: &[f64],
+        u: &[f64],
+        du: &[f64],
+    ) -> PyResult<[Vec<f64>; 3]> {
         let name = user_name(&self.key);
-        let callable = self.law.callable.bind(py);
-        let returned = if theta.len() == 1 && self.law.floats {
-            callable.call1((theta[0], u[0], du[0]))
-        } else {
-            callable.call1((
-                PyArray1::from_slice(py, theta),
-                PyArray1::from_slice(py, u),
-                PyArray1::from_slice(py, du),
-            ))
-        };
         let returned = returned.map_err(|e| {
             let err = LawError::new_err(format!("Python law `{name}` raised: {e}"));
             err.set_cause(py, Some(e));

@@ -11,6 +11,7 @@ mod law;
 mod progress;
 mod record;
 mod scene;
+mod thread_state;
 mod value;
 
 use pyo3::prelude::*;
