@@ -44,6 +44,7 @@ def solve(
     formulation: str | None = None,
     stability: bool = True,
     fallback: bool = True,
+    guess: Any = None,
 ) -> Returned: ...
 def sweep(
     scene: SceneHandle,
@@ -64,6 +65,7 @@ def sweep(
     output: str | None = None,
     dofs: str | None = None,
     progress: Callable[[float, str], Any] | None = None,
+    guess: Any = None,
 ) -> Returned: ...
 def parameter_sweep(
     scene: SceneHandle,

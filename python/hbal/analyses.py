@@ -5,7 +5,7 @@ failure after the input was checked raises :class:`hbal.NumericalError`; a marke
 (not converged, a branch that stopped) is returned with ``exit_code == 1``.
 
 Option names are the command line's, with ``_`` for ``-``; ``--from`` is ``start`` (``from``
-is a Python keyword).
+is a Python keyword) and ``--start FILE`` is ``guess=`` (a previous solve's result).
 """
 
 from __future__ import annotations
@@ -45,10 +45,12 @@ def solve(
     formulation: str | None = None,
     stability: bool = True,
     fallback: bool = True,
+    guess: SolveResult | dict | None = None,
 ) -> SolveResult | TorusSolveResult:
     """One periodic solution with its error estimate, Floquet stability and element outputs
     (``hbal solve``). ``harmonics`` is H or ``"auto"``, ``"auto:harmonics"``, ...;
-    ``stability=False`` is ``--no-stability``, ``fallback=False`` ``--no-fallback``."""
+    ``stability=False`` is ``--no-stability``, ``fallback=False`` ``--no-fallback``,
+    ``guess`` (a previous solve's result or record) ``--start``."""
     s = _scene(scene)
     record, code, seconds = _hbal.solve(
         s._handle,
@@ -59,6 +61,7 @@ def solve(
         formulation=formulation,
         stability=stability,
         fallback=fallback,
+        guess=guess,
     )
     return (TorusSolveResult if s.on_torus else SolveResult)(record, code, seconds)
 
@@ -82,11 +85,13 @@ def sweep(
     output: str | None = None,
     dofs: str | Sequence[str] | None = None,
     progress: Callable[[float, str], None] | None = None,
+    guess: SolveResult | dict | None = None,
 ) -> SweepResult | TorusSweepResult:
     """The response over speed from ``start`` (default the scene's speed) to ``to``, in the
     scene's unit, through turning points, with stability (``hbal sweep``).
     ``progress(fraction, stage)`` is called along the way; Ctrl-C stops the sweep and raises
-    ``KeyboardInterrupt``."""
+    ``KeyboardInterrupt``. ``guess`` (a solve's result or record) is ``--start``: the branch
+    starts from it, at its speed unless ``start`` is given."""
     s = _scene(scene)
     if dofs is not None and not isinstance(dofs, str):
         dofs = ",".join(dofs)
@@ -108,6 +113,7 @@ def sweep(
         output=output,
         dofs=dofs,
         progress=progress,
+        guess=guess,
     )
     return (TorusSweepResult if s.on_torus else SweepResult)(record, code, seconds)
 

@@ -78,6 +78,26 @@ fn formulation_of(name: Option<&str>) -> PyResult<Formulation> {
         .map_err(|e| invalid("formulation", e))
 }
 
+/// The initial guess of a solve's record (`--start FILE`; `guess=` a result or its record).
+fn start_of(
+    guess: Option<&Bound<'_, PyAny>>,
+    scene: &hbal::scene::Scene,
+) -> PyResult<Option<an::StartRecord>> {
+    let Some(g) = guess else { return Ok(None) };
+    let record = if g.hasattr("record")? {
+        g.getattr("record")?
+    } else {
+        g.clone()
+    };
+    let value = crate::value::to_value(&record, "guess")?;
+    an::start_from_record(&value, scene).map(Some).map_err(|e| {
+        invalid(
+            "guess",
+            format!("{e} (expected a solve's result or its record)"),
+        )
+    })
+}
+
 fn points_in_range(option: &str, n: usize, min: usize) -> PyResult<usize> {
     if (min..=MAX_SWEEP_POINTS).contains(&n) {
         Ok(n)
@@ -92,7 +112,7 @@ fn points_in_range(option: &str, n: usize, min: usize) -> PyResult<usize> {
 /// One periodic solution (`hbal solve`): on several base frequencies where the scene is.
 #[pyfunction]
 #[pyo3(signature = (scene, *, method=None, harmonics=None, samples=None, tolerance=None,
-    formulation=None, stability=true, fallback=true))]
+    formulation=None, stability=true, fallback=true, guess=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn solve<'py>(
     py: Python<'py>,
@@ -104,13 +124,14 @@ pub fn solve<'py>(
     formulation: Option<&str>,
     stability: bool,
     fallback: bool,
+    guess: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Returned<'py>> {
     let handle = scene.get();
     let o = overrides(method, harmonics, samples, tolerance, formulation)?;
     let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
     let s: &hbal::scene::Scene = &built;
     if s.torus.is_some() {
-        let refused = [("fallback", !fallback)];
+        let refused = [("fallback", !fallback), ("guess", guess.is_some())];
         if let Some((name, _)) = refused.iter().find(|r| r.1) {
             return Err(invalid(name, "applies to one fundamental"));
         }
@@ -119,7 +140,7 @@ pub fn solve<'py>(
         return finish(py, handle, result, |a| a.exit_code());
     }
     let settings = an::SolveSettings {
-        start: None,
+        start: start_of(guess, s)?.map(|g| (g.harmonics, "guess".to_string())),
         stability,
         fallback,
         formulation: o.formulation,
@@ -133,7 +154,8 @@ pub fn solve<'py>(
 #[pyfunction]
 #[pyo3(signature = (scene, to, *, start=None, harmonics=None, samples=None, tolerance=None,
     formulation=None, stability=true, stability_orbit="exact", max_points=None, max_step=0.5,
-    points=101, all_branches=false, error_estimate=true, output=None, dofs=None, progress=None))]
+    points=101, all_branches=false, error_estimate=true, output=None, dofs=None, progress=None,
+    guess=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -154,6 +176,7 @@ pub fn sweep<'py>(
     output: Option<String>,
     dofs: Option<String>,
     progress: Option<Py<PyAny>>,
+    guess: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Returned<'py>> {
     let handle = scene.get();
     // The sweep's tolerance is its corrector's; the scene's solver is not used.
@@ -176,6 +199,9 @@ pub fn sweep<'py>(
     };
     let mut observer = PyProgress::new(progress);
     if s.torus.is_some() {
+        if guess.is_some() {
+            return Err(invalid("guess", "applies to one fundamental"));
+        }
         let settings = an::TorusSweepSettings {
             from: start,
             to,
@@ -185,8 +211,14 @@ pub fn sweep<'py>(
         observer.raise()?;
         return finish(py, handle, result, |a| a.exit_code());
     }
+    let guess = start_of(guess, s)?.map(|g| an::SweepStart {
+        harmonics: g.harmonics,
+        omega: g.omega,
+        label: "guess".into(),
+    });
     let settings = an::SweepSettings {
         from: start,
+        start: guess,
         stability,
         orbit,
         max_points,

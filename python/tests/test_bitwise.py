@@ -91,3 +91,22 @@ def test_the_numpy_views_are_the_records_numbers():
     assert 0 <= result.max_abs[0] - x.max() < 1e-5 * result.max_abs[0]
     moduli = result.record["stability"]["moduli"]
     assert sorted(abs(result.multipliers)) == pytest.approx(sorted(moduli), rel=1e-15)
+
+
+def test_a_guess_is_the_command_lines_start_file(cli, tmp_path):
+    """`guess=` a previous result is `--start FILE` with that result's JSON."""
+    path = scene_path("gear_backlash.toml")
+    first = hbal.solve(hbal.Scene.load(path), harmonics=16)
+    start = tmp_path / "start.json"
+    start.write_text(first.to_json())
+    expected, code = cli("solve", path, "--start", str(start))
+    result = hbal.solve(hbal.Scene.load(path), guess=first)
+    assert result.exit_code == code and result.record["start"] == "guess"
+    expected["start"] = "guess"  # the label: the file's name there
+    assert_bitwise_equal(without_times(result.record), without_times(expected))
+    swept, code = cli("sweep", path, "--start", str(start), "--to", "1.2")
+    branch = hbal.sweep(hbal.Scene.load(path), 1.2, guess=first.record)
+    assert branch.exit_code == code
+    assert_bitwise_equal(without_times(branch.record)["points"], without_times(swept)["points"])
+    with pytest.raises(hbal.InputError, match="guess: DOF `x` is not in the scene"):
+        hbal.solve(hbal.Scene.load(scene_path("two_shaft_6000rpm.toml")), guess={"dofs": [{"name": "x", "harmonics": [{"order": 1, "cos": 1.0, "sin": 0.0}]}]})

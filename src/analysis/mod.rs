@@ -49,6 +49,7 @@ mod output_choice;
 mod parameter_sweep;
 mod solve;
 mod solve_record;
+mod start_record;
 mod sweep;
 mod sweep_outcome;
 mod sweep_record;
@@ -69,6 +70,7 @@ pub use parameter_sweep::{
     ParameterSweepSettings,
 };
 pub use solve::{solve, AutoRecord, SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};
+pub use start_record::{start_from_record, StartRecord};
 pub use sweep::{check_sweep, sweep, SweepAnalysis};
 pub use sweep_outcome::SweepNote;
 pub use sweep_record::SCHEMA_VERSION;

@@ -63,7 +63,7 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
 }
 
 /// The notes on a `--start` file computed at another speed or with more harmonics.
-fn start_notes(scene: &Scene, file: &Path, s: &start::Start) {
+fn start_notes(scene: &Scene, file: &Path, s: &hbal::analysis::StartRecord) {
     if let Some(w) = s.omega {
         let here = scene.basis.omega();
         if (w - here).abs() > 1e-9 * here {
