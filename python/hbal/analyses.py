@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from typing import Callable, Sequence
 
+import numpy as np
+
 from . import _hbal
 from .results import (
     CompareResult,
@@ -23,6 +25,40 @@ from .results import (
     TorusSweepResult,
 )
 from .scene import Scene
+
+
+def _flag(name: str, value) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise _hbal.InputError(f"{name}: expected True or False, got {value!r}")
+    return bool(value)
+
+
+def _count(name: str, value, *, optional: bool = True):
+    """A whole number >= 0 (None where ``optional``), for the options the Rust side takes
+    as unsigned."""
+    if value is None and optional:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise _hbal.InputError(f"{name}: expected a whole number, got {value!r}")
+    if not 0 <= int(value) < 2**63:
+        raise _hbal.InputError(f"{name}: must be a whole number >= 0, got {value}")
+    return int(value)
+
+
+def _callback(name: str, value):
+    if value is not None and not callable(value):
+        raise _hbal.InputError(f"{name}: expected a function, got {type(value).__name__}")
+    return value
+
+
+def _names(name: str, value):
+    """A comma-separated string of names from a string or a sequence of strings."""
+    if value is None or isinstance(value, str):
+        return value
+    items = list(value)
+    if not all(isinstance(x, str) for x in items):
+        raise _hbal.InputError(f"{name}: expected names (strings), got {items!r}")
+    return ",".join(items)
 
 
 def _scene(scene) -> Scene:
@@ -56,11 +92,11 @@ def solve(
         s._handle,
         method=method,
         harmonics=harmonics,
-        samples=samples,
+        samples=_count("samples", samples),
         tolerance=tolerance,
         formulation=formulation,
-        stability=stability,
-        fallback=fallback,
+        stability=_flag("stability", stability),
+        fallback=_flag("fallback", fallback),
         guess=guess,
     )
     return (TorusSolveResult if s.on_torus else SolveResult)(record, code, seconds)
@@ -93,26 +129,24 @@ def sweep(
     ``KeyboardInterrupt``. ``guess`` (a solve's result or record) is ``--start``: the branch
     starts from it, at its speed unless ``start`` is given."""
     s = _scene(scene)
-    if dofs is not None and not isinstance(dofs, str):
-        dofs = ",".join(dofs)
     record, code, seconds = _hbal.sweep(
         s._handle,
         float(to),
         start=None if start is None else float(start),
         harmonics=harmonics,
-        samples=samples,
+        samples=_count("samples", samples),
         tolerance=tolerance,
         formulation=formulation,
-        stability=stability,
+        stability=_flag("stability", stability),
         stability_orbit=stability_orbit,
-        max_points=max_points,
+        max_points=_count("max_points", max_points),
         max_step=max_step,
-        points=points,
-        all_branches=all_branches,
-        error_estimate=error_estimate,
+        points=_count("points", points, optional=False),
+        all_branches=_flag("all_branches", all_branches),
+        error_estimate=_flag("error_estimate", error_estimate),
         output=output,
-        dofs=dofs,
-        progress=progress,
+        dofs=_names("dofs", dofs),
+        progress=_callback("progress", progress),
         guess=guess,
     )
     return (TorusSweepResult if s.on_torus else SweepResult)(record, code, seconds)
@@ -135,20 +169,18 @@ def parameter_sweep(
     """The response over one numeric scene field (``hbal sweep --parameter``), e.g.
     ``elements[0].k``, at ``points`` evenly spaced values."""
     s = _scene(scene)
-    if dofs is not None and not isinstance(dofs, str):
-        dofs = ",".join(dofs)
     record, code, seconds = _hbal.parameter_sweep(
         s._handle,
         parameter,
         float(start),
         float(to),
-        points=points,
+        points=_count("points", points, optional=False),
         harmonics=harmonics,
-        samples=samples,
+        samples=_count("samples", samples),
         formulation=formulation,
-        stability=stability,
-        dofs=dofs,
-        progress=progress,
+        stability=_flag("stability", stability),
+        dofs=_names("dofs", dofs),
+        progress=_callback("progress", progress),
     )
     return ParameterSweepResult(record, code, seconds)
 
@@ -180,11 +212,13 @@ def compare(
     """Every solver (or ``methods``) and the time-domain reference, with their errors
     (``hbal compare``)."""
     s = _scene(scene)
+    if isinstance(methods, str):
+        methods = [methods]
     record, code, seconds = _hbal.compare(
         s._handle,
         methods=None if methods is None else list(methods),
         harmonics=harmonics,
-        samples=samples,
+        samples=_count("samples", samples),
         tolerance=tolerance,
         formulation=formulation,
     )

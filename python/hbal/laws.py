@@ -50,8 +50,16 @@ def check_law(name: str, law: Callable) -> None:
         raise _hbal.LawError(
             f"Python law `{name}` must return three values (f, df_du, df_ddu), got {type(returned).__name__}"
         )
+    if isinstance(returned, dict):
+        raise _hbal.LawError(f"Python law `{name}` must return three values (f, df_du, df_ddu), got a dict")
     for what, part in zip(("f", "df_du", "df_ddu"), parts):
-        a = np.asarray(part, dtype=float)
+        try:
+            raw = np.asarray(part)
+        except Exception as e:
+            raise _hbal.LawError(f"Python law `{name}`: {what} is not an array of numbers ({e})") from e
+        if raw.dtype.kind not in "fiu" or isinstance(part, np.ma.MaskedArray):
+            raise _hbal.LawError(f"Python law `{name}`: {what} must hold real numbers, got dtype {raw.dtype}")
+        a = raw.astype(float)
         if a.ndim == 0:
             a = np.full(3, float(a))
         if a.shape != (3,):

@@ -31,6 +31,10 @@ def matrix_entry(name: str, matrix: Any, n: int) -> Any:
         coo = matrix.tocoo()
         coo.sum_duplicates()
         _check_shape(name, coo.shape, n)
+        bad = np.flatnonzero(~np.isfinite(coo.data)) if np.issubdtype(coo.data.dtype, np.number) else []
+        if len(bad):
+            i = bad[0]
+            raise _hbal.InputError(f"{name}[{coo.row[i]}][{coo.col[i]}]: must be a finite number, got {coo.data[i]}")
         values = _real(name, coo.data)
         rows = (np.asarray(coo.row) + 1).tolist()
         cols = (np.asarray(coo.col) + 1).tolist()
@@ -80,7 +84,9 @@ def scene_from_matrices(
     """A scene from DOF names and structural matrices (numpy arrays or scipy.sparse, SI
     units), with elements, gear stages (``{"type": "gear_stage", ...}``), loads, an engine
     table, the operating point and the solver in the scene schema's own form."""
-    names = [str(d) for d in dofs]
+    if isinstance(dofs, str) or not all(isinstance(d, str) for d in dofs):
+        raise _hbal.InputError(f"dofs: expected a list of names (strings), got {dofs!r}")
+    names = list(dofs)
     doc: dict[str, Any] = {"dofs": names}
     if description is not None:
         doc["description"] = description
@@ -88,11 +94,14 @@ def scene_from_matrices(
     for name in _MATRICES:
         if given[name] is not None:
             doc[name] = matrix_entry(name, given[name], len(names))
-    if elements:
-        doc["elements"] = [dict(e) for e in elements]
-    if loads:
-        doc["loads"] = [dict(x) for x in loads]
+    for key, items in (("elements", elements), ("loads", loads)):
+        if any(not isinstance(x, Mapping) for x in items):
+            raise _hbal.InputError(f"{key}: expected a list of dicts (the scene schema's tables), got {list(items)!r}")
+        if items:
+            doc[key] = [dict(x) for x in items]
     for key, value in (("fundamental", fundamental), ("harmonics", harmonics), ("engine", engine), ("solver", solver)):
         if value is not None:
+            if not isinstance(value, Mapping):
+                raise _hbal.InputError(f"{key}: expected a dict (the scene schema's table), got {value!r}")
             doc[key] = dict(value)
     return Scene(doc, file="<matrices>", laws=laws)

@@ -62,8 +62,13 @@ def run(
         raise _hbal.InputError("studies of scenes on several base frequencies are not supported yet")
     if (speeds is None) == (sweep_to is None):
         raise _hbal.InputError("give either speeds (a solve at each) or sweep_to (a sweep per variant)")
-    variants = [dict(v) for v in variants]
+    variants = _checked_variants(variants)
     paths = sorted({p for v in variants for p in v})
+    if speeds is not None and f"fundamental.{scene.speed_unit}" in paths:
+        raise _hbal.InputError(
+            f"variants: `fundamental.{scene.speed_unit}` is the speed, which `speeds` sets; sweep it with speeds instead"
+        )
+    _check_options(options, sweep_to is not None)
     spec = {
         "speeds": None if speeds is None else [float(s) for s in speeds],
         "sweep": None if sweep_to is None else {"to": float(sweep_to), "start": None if sweep_from is None else float(sweep_from)},
@@ -111,6 +116,40 @@ def run(
     return table
 
 
+def _checked_variants(variants) -> list[dict]:
+    """Each variant a dict of field paths and finite real numbers (numpy numbers as floats)."""
+    if hasattr(variants, "to_dict") and hasattr(variants, "columns"):
+        variants = variants.to_dict("records")  # a pandas DataFrame: one variant per row
+    checked = []
+    for i, v in enumerate(variants):
+        if not isinstance(v, Mapping):
+            raise _hbal.InputError(f"variants[{i}]: expected a dict of field paths and numbers, got {type(v).__name__}")
+        row = {}
+        for path, x in v.items():
+            if not isinstance(path, str):
+                raise _hbal.InputError(f"variants[{i}]: field paths must be strings, got {path!r}")
+            if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)) or not np.isfinite(x):
+                raise _hbal.InputError(f"variants[{i}][{path!r}]: expected a finite number, got {x!r}")
+            row[path] = float(x)
+        checked.append(row)
+    return checked
+
+
+def _check_options(options, sweeping: bool) -> None:
+    """The options are those of :func:`hbal.sweep` or :func:`hbal.solve`, checked before any work."""
+    import inspect
+
+    target = sweep if sweeping else solve
+    taken = {"to", "start", "progress"} if sweeping else set()
+    bad = sorted(set(options or {}) & taken)
+    if bad:
+        raise _hbal.InputError(f"options: {bad} are set by the study (sweep_to, sweep_from)")
+    try:
+        inspect.signature(target).bind(None, *([0.0] if sweeping else []), **dict(options or {}))
+    except TypeError as e:
+        raise _hbal.InputError(f"options: {e} (the options of hbal.{target.__name__})") from e
+
+
 def load(out: str | os.PathLike):
     """The table of a study written to ``out`` (complete or not)."""
     import pandas as pd
@@ -156,7 +195,10 @@ class _Store:
         self.out = os.fspath(out)
         self.paths = spec["paths"]
         os.makedirs(self.out, exist_ok=True)
-        settings = {"scene": scene.to_dict(), "variants": variants, "spec": {**spec, "options": repr(spec["options"])}}
+        # The laws by name and function (an edited law body is not seen: use another out then).
+        laws = {n: f"{getattr(f, '__module__', '')}.{getattr(f, '__qualname__', repr(f))}" for n, f in scene.laws.items()}
+        settings = {"scene": scene.to_dict(), "laws": laws, "variants": variants,
+                    "spec": {**spec, "options": repr(spec["options"])}}
         digest = hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()
         meta = os.path.join(self.out, "study.json")
         if os.path.exists(meta):
@@ -193,7 +235,7 @@ def run_chunk(payload, items) -> list[tuple]:
 
 
 def _head(index, fields, spec) -> tuple:
-    return (index, *(float(fields.get(p, np.nan)) for p in spec["paths"]))
+    return (index, *(fields.get(p, np.nan) for p in spec["paths"]))
 
 
 def _failure(index, fields, speed, reason, spec) -> tuple:

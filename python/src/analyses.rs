@@ -4,17 +4,14 @@
 //! (what `hbal ... --json` prints, as Python objects, bit for bit, built when first read) and the exit code of the
 //! command-line contract (0, or 1 where the result is marked) and the library call's wall time.
 
-use crate::errors::InputError;
+use crate::options::{
+    formulation_of, orbit_of, overrides, points_in_range, refuse_on_torus, start_of,
+};
 use crate::progress::PyProgress;
 use crate::record::{Record, ToRecord};
-use crate::scene::{error, SceneHandle};
+use crate::scene::{Prepared, SceneHandle};
 use hbal::analysis as an;
-use hbal::scene::{HarmonicsOverride, Overrides};
-use hbal::Formulation;
 use pyo3::prelude::*;
-
-/// The most points of a sweep (as `--points`, `--max-points` of the command line).
-const MAX_SWEEP_POINTS: usize = 100_000;
 
 /// What an analysis returns to Python: its record, its exit code and the wall time of the
 /// library's call alone (s; what the binding adds around it is the rest of the Python call).
@@ -32,81 +29,16 @@ fn timed<T: Send>(py: Python<'_>, analysis: impl FnOnce() -> T + Send) -> (T, f6
 /// The record and exit code of an analysis, or its error (a Python law's failure first).
 fn finish<'py, T: ToRecord + 'static>(
     py: Python<'py>,
-    handle: &SceneHandle,
+    prepared: &Prepared<'_>,
     (result, seconds): (hbal::Result<T>, f64),
     exit_code: impl FnOnce(&T) -> u8,
 ) -> PyResult<Returned<'py>> {
-    if let Some(e) = handle.law_failure() {
+    if let Some(e) = prepared.slot.take() {
         return Err(e);
     }
-    let analysis = result.map_err(|e| error(py, handle, e))?;
+    let analysis = result.map_err(|e| prepared.error(py, e))?;
     let code = exit_code(&analysis);
     Ok((Bound::new(py, Record::new(analysis))?, code, seconds))
-}
-
-fn invalid(option: &str, reason: impl std::fmt::Display) -> PyErr {
-    InputError::new_err(format!("{option}: {reason}"))
-}
-
-/// The solver overrides (`--method`, `--harmonics`, `--samples`, `--tolerance`,
-/// `--formulation`).
-fn overrides(
-    method: Option<String>,
-    harmonics: Option<&Bound<'_, PyAny>>,
-    samples: Option<usize>,
-    tolerance: Option<f64>,
-    formulation: Option<&str>,
-) -> PyResult<Overrides> {
-    let harmonics = harmonics
-        .map(|h| -> PyResult<HarmonicsOverride> {
-            let text = h.str()?.to_string();
-            text.parse().map_err(|e| invalid("harmonics", e))
-        })
-        .transpose()?;
-    Ok(Overrides {
-        method,
-        harmonics,
-        samples,
-        tolerance,
-        formulation: formulation_of(formulation)?,
-    })
-}
-
-fn formulation_of(name: Option<&str>) -> PyResult<Formulation> {
-    name.unwrap_or("auto")
-        .parse()
-        .map_err(|e| invalid("formulation", e))
-}
-
-/// The initial guess of a solve's record (`--start FILE`; `guess=` a result or its record).
-fn start_of(
-    guess: Option<&Bound<'_, PyAny>>,
-    scene: &hbal::scene::Scene,
-) -> PyResult<Option<an::StartRecord>> {
-    let Some(g) = guess else { return Ok(None) };
-    let record = if g.hasattr("record")? {
-        g.getattr("record")?
-    } else {
-        g.clone()
-    };
-    let value = crate::value::to_value(&record, "guess")?;
-    an::start_from_record(&value, scene).map(Some).map_err(|e| {
-        invalid(
-            "guess",
-            format!("{e} (expected a solve's result or its record)"),
-        )
-    })
-}
-
-fn points_in_range(option: &str, n: usize, min: usize) -> PyResult<usize> {
-    if (min..=MAX_SWEEP_POINTS).contains(&n) {
-        Ok(n)
-    } else {
-        Err(invalid(
-            option,
-            format!("must be {min} to {MAX_SWEEP_POINTS}, got {n}"),
-        ))
-    }
 }
 
 /// One periodic solution (`hbal solve`): on several base frequencies where the scene is.
@@ -126,18 +58,14 @@ pub fn solve<'py>(
     fallback: bool,
     guess: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Returned<'py>> {
-    let handle = scene.get();
     let o = overrides(method, harmonics, samples, tolerance, formulation)?;
-    let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
-    let s: &hbal::scene::Scene = &built;
+    let p = scene.get().prepare(py, &o)?;
+    let s: &hbal::scene::Scene = &p.scene;
     if s.torus.is_some() {
-        let refused = [("fallback", !fallback), ("guess", guess.is_some())];
-        if let Some((name, _)) = refused.iter().find(|r| r.1) {
-            return Err(invalid(name, "applies to one fundamental"));
-        }
+        refuse_on_torus(&[("fallback", !fallback), ("guess", guess.is_some())])?;
         let settings = an::TorusSolveSettings { speed: None };
         let result = timed(py, || an::torus_solve(s, &settings));
-        return finish(py, handle, result, |a| a.exit_code());
+        return finish(py, &p, result, |a| a.exit_code());
     }
     let settings = an::SolveSettings {
         start: start_of(guess, s)?.map(|g| (g.harmonics, "guess".to_string())),
@@ -146,7 +74,7 @@ pub fn solve<'py>(
         formulation: o.formulation,
     };
     let result = timed(py, || an::solve(s, &settings));
-    finish(py, handle, result, |a| a.exit_code())
+    finish(py, &p, result, |a| a.exit_code())
 }
 
 /// A speed sweep (`hbal sweep --to`): through turning points with stability, or at evenly
@@ -178,30 +106,25 @@ pub fn sweep<'py>(
     progress: Option<Py<PyAny>>,
     guess: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Returned<'py>> {
-    let handle = scene.get();
-    // The sweep's tolerance is its corrector's; the scene's solver is not used.
-    let o = overrides(None, harmonics, samples, None, formulation)?;
-    let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
-    let s: &hbal::scene::Scene = &built;
+    // As the command line: the tolerance is checked with the scene's, and is the corrector's.
+    let o = overrides(None, harmonics, samples, tolerance, formulation)?;
     let points = points_in_range("points", points, 2)?;
     let max_points = max_points
         .map(|n| points_in_range("max_points", n, 1))
         .transpose()?;
-    let orbit = match stability_orbit {
-        "exact" => hbal::stability::Orbit::Exact,
-        "harmonic" => hbal::stability::Orbit::Harmonic,
-        other => {
-            return Err(invalid(
-                "stability_orbit",
-                format!("expected `exact` or `harmonic`, got `{other}`"),
-            ))
-        }
-    };
+    let orbit = orbit_of(stability_orbit)?;
+    let p = scene.get().prepare(py, &o)?;
+    let s: &hbal::scene::Scene = &p.scene;
     let mut observer = PyProgress::new(progress);
+    p.slot.stops(&observer.cancel);
     if s.torus.is_some() {
-        if guess.is_some() {
-            return Err(invalid("guess", "applies to one fundamental"));
-        }
+        refuse_on_torus(&[
+            ("guess", guess.is_some()),
+            ("all_branches", all_branches),
+            ("max_points", max_points.is_some()),
+            ("dofs", dofs.is_some()),
+            ("stability_orbit", orbit != hbal::stability::Orbit::Exact),
+        ])?;
         let settings = an::TorusSweepSettings {
             from: start,
             to,
@@ -209,7 +132,7 @@ pub fn sweep<'py>(
         };
         let result = timed(py, || an::torus_sweep(s, &settings, &mut observer));
         observer.raise()?;
-        return finish(py, handle, result, |a| a.exit_code());
+        return finish(py, &p, result, |a| a.exit_code());
     }
     let guess = start_of(guess, s)?.map(|g| an::SweepStart {
         harmonics: g.harmonics,
@@ -233,10 +156,14 @@ pub fn sweep<'py>(
         cancel: observer.cancel.clone(),
         ..an::SweepSettings::to(to)
     };
-    an::check_sweep(s, &settings).map_err(|e| error(py, handle, e))?;
+    an::check_sweep(s, &settings).map_err(|e| p.error(py, e))?;
     let result = timed(py, || an::sweep(s, &settings, &mut observer));
+    // A law's failure first: it cancelled the sweep.
+    if let Some(e) = p.slot.take() {
+        return Err(e);
+    }
     observer.raise()?;
-    finish(py, handle, result, |a| a.exit_code())
+    finish(py, &p, result, |a| a.exit_code())
 }
 
 /// A sweep of one numeric scene field (`hbal sweep --parameter`).
@@ -270,13 +197,19 @@ pub fn parameter_sweep<'py>(
         dofs,
         cancel: observer.cancel.clone(),
     };
+    // Every value's scene is built from the document, inside this analysis's failure scope.
+    let p = handle.prepare(py, &settings.overrides)?;
+    p.slot.stops(&observer.cancel);
     let (doc, file) = (&handle.document, handle.file.as_str());
-    an::check_parameter_sweep(doc, file, &settings).map_err(|e| error(py, handle, e))?;
+    an::check_parameter_sweep(doc, file, &settings).map_err(|e| p.error(py, e))?;
     let result = timed(py, || {
         an::parameter_sweep(doc, file, &settings, &mut observer)
     });
+    if let Some(e) = p.slot.take() {
+        return Err(e);
+    }
     observer.raise()?;
-    finish(py, handle, result, |a| a.exit_code())
+    finish(py, &p, result, |a| a.exit_code())
 }
 
 /// Natural frequencies and mode shapes about the periodic solution, critical speeds
@@ -291,16 +224,18 @@ pub fn modes<'py>(
     max_hz: Option<f64>,
     formulation: Option<&str>,
 ) -> PyResult<Returned<'py>> {
-    let handle = scene.get();
     let settings = an::ModesSettings {
         from: start,
         to,
         max_hz,
         formulation: formulation_of(formulation)?,
     };
-    let s = &handle.scene;
+    let p = scene
+        .get()
+        .prepare(py, &crate::scene::command_line_defaults())?;
+    let s: &hbal::scene::Scene = &p.scene;
     let result = timed(py, || an::modes(s, &settings));
-    finish(py, handle, result, |_| 0)
+    finish(py, &p, result, |_| 0)
 }
 
 /// Every solver (or those of `methods`) and the time-domain reference (`hbal compare`).
@@ -317,25 +252,28 @@ pub fn compare<'py>(
     tolerance: Option<f64>,
     formulation: Option<&str>,
 ) -> PyResult<Returned<'py>> {
-    let handle = scene.get();
     let o = overrides(None, harmonics, samples, None, formulation)?;
-    let built = handle.with(&o).map_err(|e| error(py, handle, e))?;
-    let s: &hbal::scene::Scene = &built;
+    if let Some(t) = tolerance {
+        hbal::scene::check_tolerance(t).map_err(|e| crate::options::invalid("tolerance", e))?;
+    }
+    let p = scene.get().prepare(py, &o)?;
+    let s: &hbal::scene::Scene = &p.scene;
     let settings = an::CompareSettings {
         methods,
         tolerance,
         formulation: o.formulation,
     };
     let result = timed(py, || an::compare(s, &settings));
-    finish(py, handle, result, |a| a.exit_code())
+    finish(py, &p, result, |a| a.exit_code())
 }
 
 /// Checks the scene as a solve would before its first iteration (`hbal check`).
 #[pyfunction]
 pub fn check(py: Python<'_>, scene: &Bound<'_, SceneHandle>) -> PyResult<()> {
-    let handle = scene.get();
-    let s = &handle.scene;
-    py.detach(|| an::check(s))
-        .map_err(|e| error(py, handle, e))?;
-    handle.law_failure().map_or(Ok(()), Err)
+    let p = scene
+        .get()
+        .prepare(py, &crate::scene::command_line_defaults())?;
+    let s: &hbal::scene::Scene = &p.scene;
+    py.detach(|| an::check(s)).map_err(|e| p.error(py, e))?;
+    p.slot.take().map_or(Ok(()), Err)
 }

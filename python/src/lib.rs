@@ -6,8 +6,10 @@
 //! Ctrl-C ([`progress`]).
 
 mod analyses;
+mod document;
 mod errors;
 mod law;
+mod options;
 mod progress;
 mod record;
 mod scene;
@@ -22,10 +24,10 @@ fn _hbal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::SceneHandle>()?;
     m.add_class::<record::Record>()?;
     m.add_function(wrap_pyfunction!(scene::build_scene, m)?)?;
-    m.add_function(wrap_pyfunction!(scene::parse_scene, m)?)?;
-    m.add_function(wrap_pyfunction!(scene::read_scene, m)?)?;
-    m.add_function(wrap_pyfunction!(scene::document_to_toml, m)?)?;
-    m.add_function(wrap_pyfunction!(scene::set_parameter, m)?)?;
+    m.add_function(wrap_pyfunction!(document::parse_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(document::read_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(document::document_to_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(document::set_parameter, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::solve, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::parameter_sweep, m)?)?;

@@ -41,29 +41,35 @@ macro_rules! by_serde {
 }
 by_serde!(an::TorusSolveAnalysis, an::TorusSweepAnalysis);
 
+/// The analysis, until its record is built.
+enum State {
+    Pending(Box<dyn ToRecord>),
+    Built(Value),
+}
+
 /// The record of one analysis.
 #[pyclass(frozen, module = "hbal._hbal")]
-pub struct Record(Mutex<Option<Box<dyn ToRecord>>>);
+pub struct Record(Mutex<State>);
 
 impl Record {
     pub fn new(analysis: impl ToRecord + 'static) -> Self {
-        Record(Mutex::new(Some(Box::new(analysis))))
+        Record(Mutex::new(State::Pending(Box::new(analysis))))
     }
 }
 
 #[pymethods]
 impl Record {
-    /// The record as Python objects (once: the analysis is dropped then).
+    /// The record as new Python objects. It is built on the first call (the analysis is
+    /// dropped then), with the GIL held throughout: a second thread waits for the GIL, never
+    /// for the lock while holding the GIL.
     fn to_python<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let analysis = self
-            .0
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .take()
-            .ok_or_else(|| {
-                pyo3::exceptions::PyRuntimeError::new_err("the record was read already")
-            })?;
-        let value = py.detach(|| analysis.record());
-        to_python(py, &value)
+        let mut state = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        let value = match std::mem::replace(&mut *state, State::Built(Value::Null)) {
+            State::Pending(analysis) => analysis.record(),
+            State::Built(value) => value,
+        };
+        let converted = to_python(py, &value);
+        *state = State::Built(value);
+        converted
     }
 }

@@ -1,14 +1,15 @@
 //! A scene built once for the analyses of Python: [`SceneHandle`] holds the library's
-//! [`Scene`] and the document it came from (with the registry keys of its Python laws), so
-//! that every analysis without overrides reuses the build and one with overrides builds its
-//! own from the same document.
+//! [`Scene`] and the document it came from (with the registry keys of its Python laws).
+//! An analysis without overrides of a scene without Python laws reuses the build; any other
+//! builds its own copy from the document ([`SceneHandle::prepare`]): with overrides, or with
+//! Python laws, whose failures then go to that analysis alone.
 
-use crate::errors::{scene_error, to_py};
-use crate::law::{self, FailureSlot, Registered};
+use crate::errors::{scene_error, to_py, InputError};
+use crate::law::registry::{self, FailureSlot, Registered, SlotScope, KEY_MARK};
 use crate::value::{to_python, to_value};
 use hbal::scene::{Overrides, Scene};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyString};
 use serde_json::Value;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -20,32 +21,97 @@ pub struct SceneHandle {
     /// The document as the library reads it (Python laws named by their registry keys).
     pub document: Value,
     pub file: String,
-    /// The failures of the scene's Python laws.
+    /// The failures of the scene's own build and of `check`.
     pub slot: Arc<FailureSlot>,
     keys: Vec<String>,
 }
 
 impl Drop for SceneHandle {
     fn drop(&mut self) {
-        law::unregister(&self.keys);
+        registry::unregister(&self.keys);
+    }
+}
+
+/// The scene an analysis runs on, and where its laws' failures go while it lives.
+pub struct Prepared<'a> {
+    pub scene: Built<'a>,
+    pub slot: Arc<FailureSlot>,
+    _scope: Option<SlotScope>,
+    _depth: Nesting,
+}
+
+/// How many analyses run nested on this thread (a law that runs an analysis).
+struct Nesting;
+
+/// The most analyses nested on one thread: each holds a solver's stack, and a law that runs
+/// an analysis of its own scene without end would overflow it.
+const MAX_NESTING: usize = 8;
+
+thread_local! {
+    static NESTED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+impl Nesting {
+    fn enter() -> PyResult<Self> {
+        let depth = NESTED.with(|n| n.get());
+        if depth >= MAX_NESTING {
+            return Err(InputError::new_err(format!(
+                "analyses nested more than {MAX_NESTING} deep: a Python law runs an analysis that calls the law again"
+            )));
+        }
+        NESTED.with(|n| n.set(depth + 1));
+        Ok(Nesting)
+    }
+}
+
+impl Drop for Nesting {
+    fn drop(&mut self) {
+        NESTED.with(|n| n.set(n.get().saturating_sub(1)));
+    }
+}
+
+impl Prepared<'_> {
+    /// The error to raise for `e`: a law's failure first.
+    pub fn error(&self, py: Python<'_>, e: hbal::Error) -> PyErr {
+        self.slot.take().unwrap_or_else(|| to_py(py, e))
     }
 }
 
 impl SceneHandle {
-    /// The scene with `overrides` applied: the built one where there are none, else a new
-    /// build of the document.
-    pub fn with(&self, overrides: &Overrides) -> hbal::Result<Built<'_>> {
-        if *overrides == command_line_defaults() {
-            return Ok(Built::Shared(&self.scene));
+    /// The scene of one analysis with `overrides`: the built one for a scene without Python
+    /// laws and no overrides, else a new build (inside the analysis's failure scope, which
+    /// lasts as long as the returned value: a parameter sweep's builds report there too).
+    pub fn prepare(&self, py: Python<'_>, overrides: &Overrides) -> PyResult<Prepared<'_>> {
+        let depth = Nesting::enter()?;
+        if self.keys.is_empty() && *overrides == command_line_defaults() {
+            let slot = Arc::new(FailureSlot::default());
+            let scene = Built::Shared(&self.scene);
+            return Ok(Prepared {
+                scene,
+                slot,
+                _scope: None,
+                _depth: depth,
+            });
         }
-        let mut scene = Scene::from_value(self.document.clone(), &self.file)?;
-        overrides.apply(&mut scene)?;
-        Ok(Built::Own(Box::new(scene)))
-    }
-
-    /// The first failure of a Python law since the last call, as the exception to raise.
-    pub fn law_failure(&self) -> Option<PyErr> {
-        self.slot.take()
+        let slot = Arc::new(FailureSlot::default());
+        let scope = (!self.keys.is_empty()).then(|| SlotScope::enter(slot.clone()));
+        let built = Scene::from_value(self.document.clone(), &self.file)
+            .map_err(hbal::Error::from)
+            .and_then(|mut scene| overrides.apply(&mut scene).map(|_| scene));
+        let mut prepared = Prepared {
+            scene: Built::Shared(&self.scene),
+            slot,
+            _scope: scope,
+            _depth: depth,
+        };
+        match built {
+            Ok(scene) => prepared.scene = Built::Own(Box::new(scene)),
+            Err(e) => return Err(prepared.error(py, e)),
+        }
+        if let Some(e) = prepared.slot.take() {
+            return Err(e);
+        }
+        Ok(prepared)
     }
 }
 
@@ -76,14 +142,14 @@ impl SceneHandle {
 
 /// The overrides the command line applies when none is given (`--formulation auto`): the
 /// built scene has them, so that an analysis without options reuses it.
-fn command_line_defaults() -> Overrides {
+pub fn command_line_defaults() -> Overrides {
     Overrides {
         formulation: hbal::Formulation::Auto,
         ..Overrides::default()
     }
 }
 
-/// The handle's scene, or one built with overrides.
+/// The handle's scene, or one built for an analysis.
 pub enum Built<'a> {
     Shared(&'a Scene),
     Own(Box<Scene>),
@@ -112,47 +178,56 @@ pub fn build_scene(
     laws: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<SceneHandle> {
     let mut document = to_value(document, "scene")?;
-    let slot = Arc::new(FailureSlot::default());
-    let mut keys = Vec::new();
-    let build = NEXT_BUILD.fetch_add(1, Ordering::Relaxed);
-    if let Some(laws) = laws {
-        for (name, callable) in laws.iter() {
-            let name: String = name.extract()?;
-            if name.contains('#') {
-                return Err(crate::errors::InputError::new_err(format!(
-                    "laws: the name `{name}` may not contain `#`"
-                )));
-            }
-            let key = format!("{name}#{build}");
-            let floats = law::takes_floats(py, &callable);
-            law::register(
-                key.clone(),
-                Registered {
-                    callable: callable.unbind(),
-                    slot: slot.clone(),
-                    floats,
-                },
-            );
-            rename_laws(&mut document, &name, &key);
-            keys.push(key);
+    refuse_keys(&document)?;
+    let mut named = Vec::new();
+    for (name, callable) in laws
+        .map(|l| l.iter().collect::<Vec<_>>())
+        .unwrap_or_default()
+    {
+        let name = name
+            .cast::<PyString>()
+            .map_err(|_| InputError::new_err("laws: the names must be strings"))?
+            .to_string();
+        if name.contains('#') {
+            return Err(InputError::new_err(format!(
+                "laws: the name `{name}` may not contain `#`"
+            )));
         }
+        named.push((name, callable));
+    }
+    let slot = Arc::new(FailureSlot::default());
+    let build = NEXT_BUILD.fetch_add(1, Ordering::Relaxed);
+    let mut keys = Vec::new();
+    for (name, callable) in named {
+        let key = format!("{name}{KEY_MARK}{build}");
+        let floats = crate::law::returned::takes_floats(py, &callable);
+        let callable = callable.unbind();
+        let law = Registered {
+            callable,
+            slot: slot.clone(),
+            floats,
+        };
+        registry::register(key.clone(), law);
+        rename_laws(&mut document, &name, &key);
+        keys.push(key);
     }
     // Building calls the laws (their linear part): a law's failure is the error to raise.
     let built = Scene::from_value(document.clone(), file);
     let failed = slot.take();
     let scene = match (built, failed) {
-        (Ok(mut scene), None) => {
-            command_line_defaults()
-                .apply(&mut scene)
-                .map_err(|e| crate::errors::to_py(py, e))?;
-            scene
-        }
+        (Ok(mut scene), None) => match command_line_defaults().apply(&mut scene) {
+            Ok(()) => scene,
+            Err(e) => {
+                registry::unregister(&keys);
+                return Err(to_py(py, e));
+            }
+        },
         (_, Some(failure)) => {
-            law::unregister(&keys);
+            registry::unregister(&keys);
             return Err(failure);
         }
         (Err(e), None) => {
-            law::unregister(&keys);
+            registry::unregister(&keys);
             return Err(scene_error(py, &unkeyed(e)));
         }
     };
@@ -163,6 +238,23 @@ pub fn build_scene(
         slot,
         keys,
     })
+}
+
+/// Python elements of a document name laws by the user's names: a `#` there (the registry
+/// keys' mark) is refused, so that a document cannot reach another scene's law.
+fn refuse_keys(document: &Value) -> PyResult<()> {
+    let elements = document.get("elements").and_then(Value::as_array);
+    for (i, e) in elements.into_iter().flatten().enumerate() {
+        let python = e.get("type").and_then(Value::as_str) == Some("python");
+        if let Some(law) = e.get("law").and_then(Value::as_str).filter(|_| python) {
+            if law.contains('#') {
+                return Err(InputError::new_err(format!(
+                    "scene: elements[{i}].law: `{law}` may not contain `#`"
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Every element `{ type = "python", law = name }` of `document` names `key` instead.
@@ -180,69 +272,17 @@ fn rename_laws(document: &mut Value, name: &str, key: &str) {
 
 /// A scene error with registry keys in its message written as the user's names.
 fn unkeyed(mut e: hbal::scene::SceneError) -> hbal::scene::SceneError {
-    while let Some(at) = e.message.find('#') {
-        let end = e.message[at + 1..]
+    let mut from = 0;
+    while let Some(at) = e.message[from..].find(KEY_MARK).map(|a| a + from) {
+        let digits = at + KEY_MARK.len();
+        let end = e.message[digits..]
             .find(|c: char| !c.is_ascii_digit())
-            .map_or(e.message.len(), |n| at + 1 + n);
-        e.message.replace_range(at..end, "");
+            .map_or(e.message.len(), |n| digits + n);
+        if end > digits {
+            e.message.replace_range(at..end, "");
+        } else {
+            from = digits;
+        }
     }
     e
-}
-
-/// Parses scene text (TOML, or JSON where `file` ends in `.json`) into its document, with
-/// the file's syntax checks.
-#[pyfunction]
-pub fn parse_scene<'py>(py: Python<'py>, text: &str, file: &str) -> PyResult<Bound<'py, PyAny>> {
-    let value = Scene::parse_value(text, file).map_err(|e| scene_error(py, &e))?;
-    to_python(py, &value)
-}
-
-/// Reads and parses a scene file into its document.
-#[pyfunction]
-pub fn read_scene<'py>(py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyAny>> {
-    let p = std::path::Path::new(path);
-    let text = hbal::scene::bounded_read::read_text(p).map_err(|e| {
-        let err = hbal::scene::SceneError {
-            file: path.to_string(),
-            position: None,
-            path: None,
-            message: format!("cannot read the file: {e}"),
-        };
-        scene_error(py, &err)
-    })?;
-    parse_scene(py, &text, path)
-}
-
-/// The document as TOML text.
-#[pyfunction]
-pub fn document_to_toml(document: &Bound<'_, PyAny>) -> PyResult<String> {
-    let value = to_value(document, "scene")?;
-    toml::to_string(&value).map_err(|e| {
-        crate::errors::InputError::new_err(format!("the scene cannot be written as TOML: {e}"))
-    })
-}
-
-/// `Error` of the library, for the analyses.
-pub fn error(py: Python<'_>, handle: &SceneHandle, e: hbal::Error) -> PyErr {
-    handle.law_failure().unwrap_or_else(|| to_py(py, e))
-}
-
-/// The document with the number at `path` (e.g. `elements[0].k`, `fundamental.rpm`) set to
-/// `value` (the library's `set_parameter`, as a parameter sweep and a study's variant use it).
-#[pyfunction]
-pub fn set_parameter<'py>(
-    py: Python<'py>,
-    document: &Bound<'py, PyAny>,
-    path: &str,
-    value: f64,
-) -> PyResult<Bound<'py, PyAny>> {
-    let mut doc = to_value(document, "scene")?;
-    if !value.is_finite() {
-        return Err(crate::errors::InputError::new_err(format!(
-            "`{path}`: must be a finite number, got {value}"
-        )));
-    }
-    hbal::scene::set_parameter(&mut doc, path, value)
-        .map_err(crate::errors::InputError::new_err)?;
-    to_python(py, &doc)
 }

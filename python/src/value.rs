@@ -6,7 +6,7 @@
 //! key that is not a string or an object of another type is an error naming its place
 //! (`mass[1][0]`).
 
-use pyo3::exceptions::PyValueError;
+use crate::errors::InputError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use serde_json::{Map, Number, Value};
@@ -20,12 +20,24 @@ pub fn to_value(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Value> {
         } else {
             format!("{what}: {path}")
         };
-        PyValueError::new_err(format!("{at}: {reason}"))
+        InputError::new_err(format!("{at}: {reason}"))
     })
 }
 
+/// How deep a document may nest (a scene is a few levels deep; a cycle is infinitely).
+const MAX_DEPTH: usize = 64;
+
 /// Converts `obj`; on an error `path` is left at the offending place.
 fn convert(obj: &Bound<'_, PyAny>, path: &mut String) -> Result<Value, String> {
+    convert_at(obj, path, 0)
+}
+
+fn convert_at(obj: &Bound<'_, PyAny>, path: &mut String, depth: usize) -> Result<Value, String> {
+    if depth > MAX_DEPTH {
+        return Err(format!(
+            "nested more than {MAX_DEPTH} levels deep (a list or dict that holds itself?)"
+        ));
+    }
     if obj.is_none() {
         return Ok(Value::Null);
     }
@@ -59,7 +71,7 @@ fn convert(obj: &Bound<'_, PyAny>, path: &mut String) -> Result<Value, String> {
                 .map_err(|_| format!("keys must be strings, got {}", type_name(&k)))?
                 .to_string();
             push_key(path, &key);
-            map.insert(key, convert(&v, path)?);
+            map.insert(key, convert_at(&v, path, depth + 1)?);
             path.truncate(base);
         }
         return Ok(Value::Object(map));
@@ -69,7 +81,7 @@ fn convert(obj: &Bound<'_, PyAny>, path: &mut String) -> Result<Value, String> {
         let mut items = Vec::new();
         for (i, v) in obj.try_iter().map_err(|e| e.to_string())?.enumerate() {
             path.push_str(&format!("[{i}]"));
-            items.push(convert(&v.map_err(|e| e.to_string())?, path)?);
+            items.push(convert_at(&v.map_err(|e| e.to_string())?, path, depth + 1)?);
             path.truncate(base);
         }
         return Ok(Value::Array(items));
@@ -80,7 +92,7 @@ fn convert(obj: &Bound<'_, PyAny>, path: &mut String) -> Result<Value, String> {
         if plain.hasattr("tolist").unwrap_or(false) {
             return Err(format!("cannot read a {}", type_name(obj)));
         }
-        return convert(&plain, path);
+        return convert_at(&plain, path, depth + 1);
     }
     Err(format!(
         "expected a number, string, bool, list or dict, got {}",
