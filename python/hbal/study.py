@@ -84,7 +84,7 @@ def run(
     own = executor is None
     if own:
         executor = cf.ProcessPoolExecutor()
-    workers = getattr(executor, "_max_workers", None) or os.cpu_count() or 1
+    workers = _workers(executor)
     chunk = chunk or max(1, min(50, len(todo) // (8 * workers) or 1))
     payload = (scene.to_json(indent=None), scene.file, scene.laws, spec)
     rows: list[tuple] = []
@@ -114,6 +114,17 @@ def run(
             executor.shutdown(wait=True, cancel_futures=True)
     table = store.table() if store is not None else _frame(rows, paths)
     return table
+
+
+def _workers(executor) -> int:
+    """How many tasks the executor runs at once: a pool's size, a Dask cluster's threads."""
+    client = getattr(executor, "_client", None)
+    if client is not None and hasattr(client, "nthreads"):
+        try:
+            return max(1, sum(client.nthreads().values()))
+        except Exception:  # noqa: BLE001 - a client that cannot say: the local count
+            pass
+    return getattr(executor, "_max_workers", None) or os.cpu_count() or 1
 
 
 def _checked_variants(variants) -> list[dict]:
