@@ -53,11 +53,13 @@ def check_law(name: str, law: Callable) -> None:
     if isinstance(returned, dict):
         raise _hbal.LawError(f"Python law `{name}` must return three values (f, df_du, df_ddu), got a dict")
     for what, part in zip(("f", "df_du", "df_ddu"), parts):
+        if isinstance(part, np.ma.MaskedArray):
+            raise _hbal.LawError(f"Python law `{name}`: {what} is a masked array: return plain values")
         try:
             raw = np.asarray(part)
         except Exception as e:
             raise _hbal.LawError(f"Python law `{name}`: {what} is not an array of numbers ({e})") from e
-        if raw.dtype.kind not in "fiu" or isinstance(part, np.ma.MaskedArray):
+        if raw.dtype.kind not in "fiu":
             raise _hbal.LawError(f"Python law `{name}`: {what} must hold real numbers, got dtype {raw.dtype}")
         a = raw.astype(float)
         if a.ndim == 0:

@@ -139,9 +139,14 @@ def _checked_variants(variants) -> list[dict]:
         for path, x in v.items():
             if not isinstance(path, str):
                 raise _hbal.InputError(f"variants[{i}]: field paths must be strings, got {path!r}")
-            if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)) or not np.isfinite(x):
+            number = isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, (bool, np.bool_))
+            try:
+                value = float(x) if number else np.nan
+            except OverflowError:
+                value = np.nan
+            if not np.isfinite(value):
                 raise _hbal.InputError(f"variants[{i}][{path!r}]: expected a finite number, got {x!r}")
-            row[path] = float(x)
+            row[path] = value
         checked.append(row)
     return checked
 
@@ -159,6 +164,16 @@ def _check_options(options, sweeping: bool) -> None:
         inspect.signature(target).bind(None, *([0.0] if sweeping else []), **dict(options or {}))
     except TypeError as e:
         raise _hbal.InputError(f"options: {e} (the options of hbal.{target.__name__})") from e
+    from .analyses import _count, _flag
+
+    for name, value in (options or {}).items():
+        if name in ("stability", "fallback", "all_branches", "error_estimate"):
+            _flag(f"options[{name!r}]", value)
+        elif name in ("samples", "points", "max_points"):
+            _count(f"options[{name!r}]", value)
+        elif name in ("tolerance", "max_step") and value is not None:
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
+                raise _hbal.InputError(f"options[{name!r}]: expected a finite number > 0, got {value!r}")
 
 
 def load(out: str | os.PathLike):

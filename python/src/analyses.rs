@@ -124,6 +124,7 @@ pub fn sweep<'py>(
             ("max_points", max_points.is_some()),
             ("dofs", dofs.is_some()),
             ("stability_orbit", orbit != hbal::stability::Orbit::Exact),
+            ("output", output.is_some()),
         ])?;
         let settings = an::TorusSweepSettings {
             from: start,

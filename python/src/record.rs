@@ -6,7 +6,7 @@ use crate::value::to_python;
 use hbal::analysis as an;
 use pyo3::prelude::*;
 use serde_json::Value;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// An analysis whose JSON record can be built.
 pub trait ToRecord: Send + Sync {
@@ -44,7 +44,7 @@ by_serde!(an::TorusSolveAnalysis, an::TorusSweepAnalysis);
 /// The analysis, until its record is built.
 enum State {
     Pending(Box<dyn ToRecord>),
-    Built(Value),
+    Built(Arc<Value>),
 }
 
 /// The record of one analysis.
@@ -60,16 +60,18 @@ impl Record {
 #[pymethods]
 impl Record {
     /// The record as new Python objects. It is built on the first call (the analysis is
-    /// dropped then), with the GIL held throughout: a second thread waits for the GIL, never
-    /// for the lock while holding the GIL.
+    /// dropped then). The lock is held only while Rust builds it, never while Python runs
+    /// (the conversion may run a finaliser that lets the GIL go to a second reader).
     fn to_python<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let mut state = self.0.lock().unwrap_or_else(|p| p.into_inner());
-        let value = match std::mem::replace(&mut *state, State::Built(Value::Null)) {
-            State::Pending(analysis) => analysis.record(),
-            State::Built(value) => value,
+        let value = {
+            let mut state = self.0.lock().unwrap_or_else(|p| p.into_inner());
+            let built = match std::mem::replace(&mut *state, State::Built(Arc::default())) {
+                State::Pending(analysis) => Arc::new(analysis.record()),
+                State::Built(value) => value,
+            };
+            *state = State::Built(built.clone());
+            built
         };
-        let converted = to_python(py, &value);
-        *state = State::Built(value);
-        converted
+        to_python(py, &value)
     }
 }

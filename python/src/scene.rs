@@ -200,7 +200,13 @@ pub fn build_scene(
     let mut keys = Vec::new();
     for (name, callable) in named {
         let key = format!("{name}{KEY_MARK}{build}");
-        let floats = crate::law::returned::takes_floats(py, &callable);
+        let floats = match crate::law::returned::takes_floats(py, &callable) {
+            Ok(floats) => floats,
+            Err(interrupted) => {
+                registry::unregister(&keys);
+                return Err(interrupted);
+            }
+        };
         let callable = callable.unbind();
         let law = Registered {
             callable,
@@ -211,8 +217,11 @@ pub fn build_scene(
         rename_laws(&mut document, &name, &key);
         keys.push(key);
     }
-    // Building calls the laws (their linear part): a law's failure is the error to raise.
+    // Building calls the laws (their linear part): a law's failure is the error to raise. The
+    // build has its own failure scope (it may happen inside another analysis's law).
+    let scope = SlotScope::enter(slot.clone());
     let built = Scene::from_value(document.clone(), file);
+    drop(scope);
     let failed = slot.take();
     let scene = match (built, failed) {
         (Ok(mut scene), None) => match command_line_defaults().apply(&mut scene) {

@@ -202,3 +202,49 @@ def test_bad_variants_are_refused_before_any_work(tmp_path):
         hbal.study.run(scene, [{}], speeds=[6000], options={"no_such_option": 1})
     table = hbal.study.run(scene, [{"elements[0].profile.one_tooth": np.int64(250000)}], speeds=[6000], out=tmp_path / "s")
     assert (table.status == "ok").all()
+
+
+def test_two_threads_reading_a_record_while_finalisers_run():
+    """Building the record holds no lock while Python runs (a finaliser may let the GIL go)."""
+    out = run_isolated(f"""
+import gc, threading, hbal
+class Noisy:
+    def __init__(self):
+        self.me = self
+    def __del__(self):
+        import time; time.sleep(0)
+r = hbal.sweep(hbal.Scene.load({DUFFING!r}), 2.6, start=0.5, stability=False)
+junk = [Noisy() for _ in range(3000)]
+del junk
+got = []
+threads = [threading.Thread(target=lambda: got.append(len(r.record["points"]))) for _ in range(4)]
+for t in threads: t.start()
+for t in threads: t.join()
+print(len(set(got)), len(got))
+""", timeout=60)
+    assert out.split() == ["1", "4"]
+
+
+def test_a_scene_built_inside_a_law_keeps_its_own_failures():
+    inner_doc = hbal.Scene.load(DUFFING).to_dict()
+    inner_doc["elements"][0] = {"name": "spring", "type": "python", "law": "bad", "connects": {"x": 1.0}}
+    seen = []
+
+    def builds_another(theta, u, du):
+        if armed and not seen:
+            def bad(t, u, du):
+                if np.size(u) == 64:
+                    raise ValueError("the inner scene's law")
+                return duffing(t, u, du)
+
+            try:
+                hbal.Scene(inner_doc, laws={"bad": bad})
+            except hbal.LawError as e:
+                seen.append(str(e))
+        return duffing(theta, u, du)
+
+    armed = []
+    scene = with_python_spring(builds_another, name="outer")
+    armed.append(1)
+    assert hbal.solve(scene).converged
+    assert seen and "the inner scene's law" in seen[0]

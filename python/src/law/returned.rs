@@ -10,27 +10,39 @@ use pyo3::types::PyFloat;
 /// Whether `law` gives, called with three floats, bit for bit what it gives for arrays of
 /// one sample. Then the time-domain reference and the Floquet analysis, which evaluate one
 /// sample at a time, call it with floats: numpy's arithmetic on a number costs a tenth of
-/// that on an array. A law that needs arrays (`len(u)`, `u.shape`) keeps arrays.
-pub fn takes_floats(py: Python<'_>, law: &Bound<'_, PyAny>) -> bool {
+/// that on an array. A law that needs arrays (`len(u)`, `u.shape`) keeps arrays. An
+/// interruption (Ctrl-C) during the check is the error.
+pub fn takes_floats(py: Python<'_>, law: &Bound<'_, PyAny>) -> PyResult<bool> {
     let points = [(0.0, 1e-3, 1e-2), (2.0, -0.3, 0.5), (4.0, 1.7, -2.0)];
-    points.iter().all(|&(t, u, du)| {
-        let with_floats = law
-            .call1((t, u, du))
-            .ok()
-            .and_then(|r| three(py, &r, 1).ok());
-        let with_arrays = law
-            .call1((
+    for &(t, u, du) in &points {
+        let with_floats = interrupted(py, law.call1((t, u, du)))?;
+        let with_arrays = interrupted(
+            py,
+            law.call1((
                 PyArray1::from_slice(py, &[t]),
                 PyArray1::from_slice(py, &[u]),
                 PyArray1::from_slice(py, &[du]),
-            ))
-            .ok()
-            .and_then(|r| three(py, &r, 1).ok());
-        match (with_floats, with_arrays) {
-            (Some(a), Some(b)) => (0..3).all(|j| a[j][0].to_bits() == b[j][0].to_bits()),
-            _ => false,
+            )),
+        )?;
+        let a = with_floats.and_then(|r| three(py, &r, 1).ok());
+        let b = with_arrays.and_then(|r| three(py, &r, 1).ok());
+        match (a, b) {
+            (Some(a), Some(b)) if (0..3).all(|j| a[j][0].to_bits() == b[j][0].to_bits()) => {}
+            _ => return Ok(false),
         }
-    })
+    }
+    Ok(true)
+}
+
+/// A call's value, `None` where it raised an `Exception`; an interruption is the error.
+fn interrupted<'py>(
+    py: Python<'py>,
+    r: PyResult<Bound<'py, PyAny>>,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    match r {
+        Err(e) if !e.is_instance_of::<pyo3::exceptions::PyException>(py) => Err(e),
+        r => Ok(r.ok()),
+    }
 }
 
 /// The three parts `(f, df_du, df_ddu)` of a law's return value, each of `n` samples.
