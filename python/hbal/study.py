@@ -53,7 +53,7 @@ def run(
     ``sweep_from`` (default the scene's speed) to ``sweep_to``. ``quantities`` default to every
     DOF; ``orders`` to the first ten harmonics' shaft orders. ``options`` go to
     :func:`hbal.solve` or :func:`hbal.sweep`. ``chunk`` variants make one task (default: about
-    eight tasks per worker of the pool). ``progress(done, total)`` counts variants."""
+    sixteen tasks per worker, at most 25 variants a task). ``progress(done, total)`` counts variants."""
     import pandas as pd
 
     if not isinstance(scene, Scene):
@@ -85,9 +85,9 @@ def run(
     if own:
         executor = cf.ProcessPoolExecutor()
     workers = _workers(executor)
-    chunk = chunk or max(1, min(50, len(todo) // (8 * workers) or 1))
+    chunk = chunk or max(1, min(25, len(todo) // (16 * workers) or 1))
     payload = (scene.to_json(indent=None), scene.file, scene.laws, spec)
-    rows: list[tuple] = []
+    parts: list = []
     done = len(variants) - len(todo)
     futures = {}
     try:
@@ -97,11 +97,11 @@ def run(
         if progress:
             progress(done, len(variants))
         for f in cf.as_completed(futures):
-            chunk_rows = f.result()
+            part = f.result()
             if store is not None:
-                store.write(futures[f], chunk_rows)
+                store.write(futures[f], part)
             else:
-                rows.extend(chunk_rows)
+                parts.append(part)
             done += len(futures[f])
             if progress:
                 progress(done, len(variants))
@@ -112,8 +112,9 @@ def run(
     finally:
         if own:
             executor.shutdown(wait=True, cancel_futures=True)
-    table = store.table() if store is not None else _frame(rows, paths)
-    return table
+    if store is not None:
+        return store.table()
+    return _sorted(pd.concat(parts, ignore_index=True)) if parts else _frame([], paths)
 
 
 def _workers(executor) -> int:
@@ -238,26 +239,26 @@ class _Store:
                 json.dump({"digest": digest, "variants": len(variants), "paths": self.paths}, f)
         self.done = set(load(self.out)["variant"].astype(int).tolist())
 
-    def write(self, items, rows: list[tuple]) -> None:
+    def write(self, items, part) -> None:
         ids = [i for i, _ in items]
         name = f"part-{min(ids):07d}-{max(ids):07d}"
         tmp = os.path.join(self.out, f".{name}.tmp")
-        _frame(rows, self.paths).to_parquet(tmp, index=False)
+        part.to_parquet(tmp, index=False)
         os.replace(tmp, os.path.join(self.out, name + ".parquet"))
 
     def table(self):
         return load(self.out)
 
 
-def run_chunk(payload, items) -> list[tuple]:
-    """A task: the rows of the variants ``items`` (pairs of index and fields), as tuples in the
-    table's column order (light to ship back)."""
+def run_chunk(payload, items):
+    """A task: the table of the variants ``items`` (pairs of index and fields), built where
+    it runs (a DataFrame ships back in a few buffers, light for the client)."""
     text, file, laws, spec = payload
     base = Scene(json.loads(text), file=file, laws=laws)
     rows = []
     for index, fields in items:
         rows.extend(_variant_rows(base, index, fields, spec))
-    return rows
+    return _frame(rows, spec["paths"])
 
 
 def _head(index, fields, spec) -> tuple:
