@@ -5,7 +5,7 @@
 The result is one tidy table, a row per variant, speed, quantity and order: ``variant``, the
 varied fields (one column per path), ``speed`` (the scene's unit), ``quantity`` (a DOF, or
 ``u(element)``/``f(element)``: an element's coordinate, e.g. a gear stage's transmission error,
-or its force), ``order`` (shaft order), ``amplitude``, ``phase`` (rad, of ``c − i s``),
+or its force, which only solves at ``speeds`` give), ``order`` (shaft order), ``amplitude``, ``phase`` (rad, of ``c − i s``),
 ``stable``, ``error_estimate``, ``status`` (``ok`` or ``failed``) and ``reason``. A variant that
 fails (a field the scene does not have, a law that raises, a solve that does not converge, a
 branch that stops) has a row with ``status == "failed"`` and the reason, never dropped.
@@ -209,9 +209,9 @@ def _check_quantities(scene: Scene, spec: dict) -> None:
     dofs, elements = set(scene.dofs), set(scene.elements)
     for q in spec["quantities"]:
         element = q[2:-1] if q[:2] in ("u(", "f(") and q.endswith(")") else None
-        if q in dofs or (element in elements and spec["sweep"] is None):
+        if q in dofs or (element in elements and (spec["sweep"] is None or q.startswith("u("))):
             continue
-        what = "a DOF" if spec["sweep"] is not None else "a DOF, u(element) or f(element)"
+        what = "a DOF or u(element)" if spec["sweep"] is not None else "a DOF, u(element) or f(element)"
         raise _hbal.InputError(f"quantities: `{q}` is not {what} of the scene (DOFs: {sorted(dofs)})")
 
 
@@ -281,8 +281,15 @@ def _variant_rows(base: Scene, index: int, fields: dict, spec: dict) -> list[tup
         except (_hbal.InputError, _hbal.NumericalError) as e:
             return [_failure(index, fields, np.nan, f"{type(e).__name__}: {e}", spec)]
         dofs = branch.record["harmonics_dofs"]
+        weights = scene._info["element_weights"]
         for p in branch.points:
             entries = {d: h for d, h in zip(dofs, p["harmonics"])}
+            try:
+                for q in spec["quantities"]:
+                    if q not in entries:
+                        entries[q] = _coordinate(q[2:-1], weights, entries, scene.dofs)
+            except KeyError as e:
+                return [_failure(index, fields, np.nan, str(e.args[0]), spec)]
             rows += _rows(index, fields, p["speed"], entries, spec, p["stable"], p["error_estimate"])
         if not branch.ok:
             rows.append(_failure(index, fields, np.nan, f"branch: {branch.stop}", spec))
@@ -303,6 +310,19 @@ def _variant_rows(base: Scene, index: int, fields: dict, spec: dict) -> list[tup
             entries[f"f({e['name']})"] = e["force"]["harmonics"]
         rows += _rows(index, fields, speed, entries, spec, r.stable, r.error_estimate)
     return rows
+
+
+def _coordinate(element: str, weights: dict, entries: dict, dofs: list) -> list[dict]:
+    """The harmonics of an element's coordinate u = Σ w_i q_i from its DOFs' harmonics."""
+    total = None
+    for i, w in weights[element]:
+        if dofs[i] not in entries:
+            raise KeyError(f"u({element}) needs the harmonics of DOF `{dofs[i]}`, which the sweep did not report (options dofs=)")
+        part = np.array([complex(h["cos"], -h["sin"]) for h in entries[dofs[i]]]) * w
+        total = part if total is None else total + part
+    first = next(iter(entries.values()))
+    return [{"harmonic": h["harmonic"], "shaft_order": h["shaft_order"], "cos": z.real, "sin": -z.imag}
+            for h, z in zip(first, total)]
 
 
 def _rows(index, fields, speed, entries, spec, stable, error_estimate) -> list[tuple]:

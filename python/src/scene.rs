@@ -135,6 +135,10 @@ impl SceneHandle {
             "operating_point": s.operating_point,
             "torus": s.torus.is_some(),
             "notes": s.notes,
+            // u = Σ w_i q_i of every element: its coordinate from the DOFs' harmonics.
+            "element_weights": s.model.elements().iter()
+                .map(|e| (e.name().to_string(), serde_json::json!(e.weights())))
+                .collect::<serde_json::Map<_, _>>(),
         });
         to_python(py, &info)
     }

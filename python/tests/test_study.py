@@ -130,3 +130,19 @@ def test_percentile_bands_and_their_plot(two_shaft, tmp_path):
     path = tmp_path / "bands.svg"
     hbal.plot_bands(table, "u(mesh)", [4.0, 8.0], path, unit="rpm")
     assert path.read_text().startswith("<?xml") and path.stat().st_size > 5000
+
+
+def test_a_study_of_sweeps_gives_the_transmission_error_from_the_dofs():
+    """u(mesh) of a swept variant is w·q of its DOFs' harmonics: the element coordinate a
+    solve at the same speed reports."""
+    scene = hbal.Scene.load(scene_path("free_free_drivetrain.toml"))
+    table = study.run(scene, [{}], sweep_to=3000.0, sweep_from=1000.0, quantities=["u(mesh)", "pinion"], orders=[20.0])
+    assert (table.status == "ok").all()
+    te = table[table.quantity == "u(mesh)"]
+    row = te.iloc[len(te) // 2]
+    direct = hbal.solve(scene.with_parameter("fundamental.rpm", row.speed), stability=False)
+    k = int(np.flatnonzero(np.isclose(direct.orders, 20.0))[0])
+    expected = abs(direct.element("mesh")["coordinate"]["harmonics"][k])
+    assert abs(row.amplitude - expected) <= 1e-6 * expected
+    with pytest.raises(hbal.InputError, match="f\\(mesh\\)"):
+        study.run(scene, [{}], sweep_to=3000.0, quantities=["f(mesh)"])
