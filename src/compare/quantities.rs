@@ -8,7 +8,8 @@
 //!
 //! `e_x = max_j |(x_a - x̄_a)(θ_j) - (x_b - x̄_b)(θ_j)| / max(x_b - min x_b, 1e-6 |x̄_b|)`
 //!
-//! over `N` samples of the period, with `x_b` the reference. The quantities are every DOF,
+//! over `N` samples of the period, with `x_b` the reference (a reference without any range
+//! is measured against `x_a`'s range instead). The quantities are every DOF,
 //! every element coordinate `u = w·q` (a gear stage's transmission error) and every element
 //! force `f(θ, u, u̇)` along the orbit (a mesh force; not for laws with memory). The samples
 //! carry every harmonic of both arrays, so what the shorter one lacks counts.
@@ -147,13 +148,22 @@ fn error_of(quantity: Quantity, a: &[f64], b: &[f64]) -> Option<QuantityError> {
     if scale == 0.0 && diff == 0.0 {
         return None;
     }
+    // A reference without range (a contact that never closes in it) against a moving `a`:
+    // `a`'s own range is the scale, so the error is between 1/2 and 1 ("wrong by its whole
+    // size"), finite, never 0/0 or infinity in a document.
+    let scale = if scale > 0.0 {
+        scale
+    } else {
+        let (lo, hi) = a
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, m), &x| {
+                (l.min(x), m.max(x))
+            });
+        hi - lo
+    };
     Some(QuantityError {
         quantity,
-        error: if scale > 0.0 {
-            diff / scale
-        } else {
-            f64::INFINITY
-        },
+        error: diff / scale,
         range,
     })
 }
@@ -165,4 +175,26 @@ pub fn worst(errors: &[QuantityError], keep: impl Fn(&Quantity) -> bool) -> Opti
         .filter(|e| keep(&e.quantity))
         .copied()
         .max_by(|x, y| x.error.total_cmp(&y.error))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reference_without_range_is_measured_by_the_other_range() {
+        // The reference's contact never closes (force 0); the approximation's swings ±2.
+        let b = [0.0; 8];
+        let a = [0.0, 2.0, 0.0, -2.0, 0.0, 2.0, 0.0, -2.0];
+        let e = error_of(Quantity::Force(0), &a, &b).expect("a difference");
+        assert_eq!(e.range, 0.0);
+        // max |a - mean a| = 2 against a's range 4.
+        assert_eq!(e.error, 0.5);
+        // Both without range: nothing to report.
+        assert!(error_of(Quantity::Force(0), &b, &b).is_none());
+        // The ordinary case: a's dynamic part off by 0.1 on a range of 4.
+        let c: Vec<f64> = a.iter().map(|x| 1.05 * x).collect();
+        let e = error_of(Quantity::Dof(0), &c, &a).expect("a difference");
+        assert!((e.error - 0.1 / 4.0).abs() < 1e-15, "{}", e.error);
+    }
 }

@@ -1,6 +1,7 @@
 //! The hostile inputs of issue 13 that produce non-finite values: stopped where they arise,
 //! named, never printed as `null`, NaN or inf (forces, library errors, parameter sweeps).
 
+use crate::common::hostile::{judge_document, run_limited, write, Document};
 use crate::hostile_input::{edited, example, expect, temp_dir};
 use hbal::scene::Scene;
 use hbal::{HarmonicBalance, HarmonicBasis, Model, Newton};
@@ -123,5 +124,29 @@ fn parameter_sweep_failures_are_honest() {
         "cannot create the directory",
     );
     assert!(run.stdout.is_empty(), "{}", run.stdout);
+    let _ = std::fs::remove_dir_all(temp_dir());
+}
+
+/// Found by the hostile property test on CI: the gear pair without mean load never closes its
+/// contact in the time-domain reference (mesh force identically 0) while the unconverged
+/// Newton iterate does. The worst quantity's error is measured against the iterate's own
+/// range (between 1/2 and 1), not printed as `null` (infinity).
+#[test]
+fn a_reference_quantity_without_range_has_a_finite_error() {
+    let scene = edited(
+        "gear_backlash.toml",
+        "order = 0, cos = 0.1",
+        "order = 0, cos = 0.0",
+    );
+    let file = write(&temp_dir(), "no_mean_load.toml", &scene);
+    let run = run_limited(&["compare", "--json", &file, "--method", "newton"]);
+    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    assert!(run.stderr.contains("no method converged"), "{}", run.stderr);
+    judge_document(&run, Document::Compare).unwrap_or_else(|(b, w)| panic!("{b:?}: {w}"));
+    assert!(!run.stdout.contains("null"), "{}", run.stdout);
+    let doc: serde_json::Value = serde_json::from_str(&run.stdout).expect("one JSON object");
+    let worst = &doc["methods"][0]["worst_quantity_vs_time_domain"];
+    let error = worst["error"].as_f64().expect("a finite error");
+    assert!((0.5..=1.0).contains(&error), "{worst}");
     let _ = std::fs::remove_dir_all(temp_dir());
 }
