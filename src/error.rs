@@ -172,6 +172,11 @@ pub enum Error {
     /// A scene that cannot be read or does not follow the schema (bad input).
     #[error(transparent)]
     Scene(#[from] crate::scene::SceneError),
+    /// An output directory or file that cannot be written, or a name that cannot be part of
+    /// a file name there ([`crate::render`]; bad input: nothing is computed before it is
+    /// checked).
+    #[error("{0}")]
+    Output(String),
 }
 
 impl Error {

@@ -62,6 +62,7 @@ pub mod harmonic;
 pub mod jacobian;
 pub mod linear;
 pub mod model;
+pub mod render;
 pub mod report;
 pub mod residual;
 pub mod scene;

@@ -5,7 +5,6 @@
 
 use super::{load, Failure, SolverArgs};
 use hbal::analysis::{CompareAnalysis, CompareSettings};
-use hbal::report::{line_plot, Axis, Series};
 use std::path::Path;
 
 pub(crate) fn compare(
@@ -16,7 +15,8 @@ pub(crate) fn compare(
 ) -> Result<u8, Failure> {
     let scene = load(path, args)?;
     if let Some(dir) = out {
-        super::prepare_out(dir, &["residual_histories.svg".to_string()])?;
+        hbal::render::prepare_out(dir, &hbal::render::compare_files())
+            .map_err(|e| super::failure(e, &scene.file))?;
     }
     let settings = CompareSettings {
         methods: args
@@ -44,24 +44,10 @@ pub(crate) fn compare(
         table(&a);
     }
     if let Some(dir) = out {
-        std::fs::create_dir_all(dir)?;
-        let histories: Vec<Series> = a
-            .methods
-            .iter()
-            .map(|m| {
-                let points = m.solution.history.iter().enumerate();
-                Series::line(&m.method, points.map(|(i, r)| (i as f64, *r)).collect())
-            })
-            .collect();
-        let (x, y) = (Axis::linear("iteration"), Axis::log("relative residual"));
-        line_plot(
-            &dir.join("residual_histories.svg"),
-            "Residual histories",
-            &x,
-            &y,
-            &histories,
-        )
-        .unwrap_or_else(super::plot_warning);
+        let mut warnings = Vec::new();
+        hbal::render::write_compare_files(dir, &a, &mut warnings)
+            .map_err(|e| super::failure(e, &scene.file))?;
+        super::print_warnings(&warnings);
     }
     if a.exit_code() != 0 {
         eprintln!(

@@ -3,7 +3,6 @@
 //! `--harmonics`, `--samples`, `--tolerance`) and scene loading with them, and the JSON of
 //! Floquet multipliers. Each subcommand lives in its own file below.
 
-use anyhow::Context;
 use hbal::scene::Scene;
 use std::path::Path;
 
@@ -24,23 +23,17 @@ pub(crate) mod compare;
 pub(crate) mod dof_selection;
 pub(crate) mod element_report;
 pub(crate) mod modes;
-pub(crate) mod order_cuts;
 pub(crate) mod parameter_sweep;
 pub(crate) mod progress;
 mod quantity_report;
 pub(crate) mod report;
-pub(crate) mod report_html;
 pub(crate) mod solve;
-pub(crate) mod solve_exact;
-mod solve_files;
 mod solve_text;
 pub(crate) mod start;
 pub(crate) mod sweep;
 pub(crate) mod sweep_command;
-mod sweep_files;
 pub(crate) mod sweep_summary;
 mod sweep_text;
-pub(crate) mod torus_report;
 pub(crate) mod torus_solve;
 pub(crate) mod torus_sweep;
 
@@ -64,17 +57,21 @@ pub(crate) fn exit_code(e: &hbal::Error) -> u8 {
     e.exit_code()
 }
 
-/// A plot that cannot be drawn (nothing finite to show) is a warning on stderr: the
-/// computation and its CSV files stand, and the exit code stays the computation's.
-pub(crate) fn plot_warning(e: Box<dyn std::error::Error>) {
-    eprintln!("warning: plot: {e}");
+/// The warnings of a rendering (plots that could not be drawn: the computation and its CSV
+/// files stand, and the exit code stays the computation's).
+pub(crate) fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
 }
 
 /// A library error with the scene's name and its exit code ([`exit_code`]).
 pub(crate) fn failure(e: hbal::Error, file: &str) -> Failure {
     let code = exit_code(&e);
     // A scene error names its file already.
-    let named = matches!(&e, hbal::Error::Scene(s) if s.file == file);
+    // A scene error names its file already; an output error is about the output.
+    let named = matches!(&e, hbal::Error::Scene(s) if s.file == file)
+        || matches!(&e, hbal::Error::Output(_));
     let error = anyhow::Error::new(e);
     Failure {
         code,
@@ -162,110 +159,4 @@ pub(crate) fn modulus(x: f64) -> String {
     }
 }
 
-/// A speed for titles: up to 6 significant digits, no trailing zeros (`2000`, `1.3455`).
-pub(crate) fn speed_text(v: f64) -> String {
-    let digits = if v == 0.0 || !v.is_finite() {
-        0
-    } else {
-        (5 - v.abs().log10().floor() as i32).clamp(0, 12) as usize
-    };
-    let s = format!("{v:.digits$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
-}
-
-/// Makes `--out DIR` ready before any work: creates it, writes and removes a probe file, and
-/// checks that none of `files` (the names the subcommand writes there) is a directory or a
-/// file it cannot write, so that an unusable directory is bad input (exit 2, nothing written)
-/// instead of a failure after the run.
-pub(crate) fn prepare_out(dir: &Path, files: &[String]) -> Result<(), Failure> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("--out {}: cannot create the directory", dir.display()))?;
-    let probe = dir.join(".hbal_write_test");
-    std::fs::write(&probe, b"")
-        .with_context(|| format!("--out {}: cannot write into the directory", dir.display()))?;
-    let _ = std::fs::remove_file(probe);
-    for name in files {
-        let path = dir.join(name);
-        let Ok(meta) = std::fs::metadata(&path) else {
-            continue;
-        };
-        if meta.is_dir() {
-            return Err(anyhow::anyhow!(
-                "--out {}: {} is a directory where hbal writes a file: move it or choose another --out",
-                dir.display(),
-                path.display()
-            )
-            .into());
-        }
-        std::fs::OpenOptions::new()
-            .append(true)
-            .open(&path)
-            .with_context(|| format!("--out {}: cannot write {}", dir.display(), path.display()))?;
-    }
-    Ok(())
-}
-
-/// The files `hbal solve --out` writes (those of a converged solve and of an unconverged
-/// iterate).
-pub(crate) fn solve_files() -> Vec<String> {
-    let names = [
-        "harmonics.csv",
-        "time_series.csv",
-        "elements.csv",
-        "time_series.svg",
-        "spectrum.svg",
-    ];
-    let prefixed = names.iter().map(|n| format!("not_converged_{n}"));
-    names
-        .iter()
-        .map(|n| n.to_string())
-        .chain(prefixed)
-        .collect()
-}
-
-/// The files `hbal sweep --out` writes besides the switched branches' (`branch_1.csv`, ...):
-/// the branch, the order cuts and one frequency response per reported DOF of `dofs`.
-pub(crate) fn sweep_files<'a>(dofs: impl Iterator<Item = &'a String>) -> Vec<String> {
-    let names = [
-        "branch.csv",
-        "order_cuts.csv",
-        "order_cuts.svg",
-        "waterfall.svg",
-    ];
-    let plots = dofs.map(|d| format!("frequency_response_{d}.svg"));
-    names.iter().map(|n| n.to_string()).chain(plots).collect()
-}
-
-/// The files `hbal modes --out` writes.
-pub(crate) fn modes_files() -> Vec<String> {
-    vec!["modes.csv".into(), "campbell.svg".into()]
-}
-
-/// Checks that `name` (of a DOF or an element, `what`) can be part of a file name in `--out`:
-/// no path separators, no control characters, not empty, not `.` or `..`; nothing is written
-/// outside `--out`.
-///
-/// ```ignore
-/// assert!(file_name_part("gear", "DOF").is_ok());
-/// assert!(file_name_part("../gear", "DOF").is_err());
-/// ```
-pub(crate) fn file_name_part(name: &str, what: &str) -> Result<(), Failure> {
-    let bad = name.is_empty()
-        || name == "."
-        || name == ".."
-        || name
-            .chars()
-            .any(|c| c == '/' || c == '\\' || c == ':' || c.is_control());
-    if bad {
-        return Err(anyhow::anyhow!(
-            "{what} `{}` cannot be part of a file name in --out (no `/`, `\\`, `:`, control characters, `.` or `..`): rename it",
-            name.escape_debug()
-        )
-        .into());
-    }
-    Ok(())
-}
+pub(crate) use hbal::render::speed_text;

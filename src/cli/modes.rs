@@ -4,11 +4,8 @@
 //! it as a table or JSON; a Campbell diagram and `modes.csv` with `--out`.
 
 use super::{load, Failure, SolverArgs};
-use anyhow::Context;
 use hbal::analysis::{ModesAnalysis, ModesSettings};
-use hbal::report::{line_plot, Axis, NaturalFrequencies, Series};
-use hbal::scene::Scene;
-use std::f64::consts::TAU;
+use hbal::report::NaturalFrequencies;
 use std::path::Path;
 
 /// Options of `hbal modes`.
@@ -24,7 +21,8 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     let as_json = opts.json;
     let scene = load(path, args)?;
     if let Some(dir) = opts.out {
-        super::prepare_out(dir, &super::modes_files())?;
+        hbal::render::prepare_out(dir, &hbal::render::modes_files())
+            .map_err(|e| super::failure(e, &scene.file))?;
     }
     let settings = ModesSettings {
         from: opts.from,
@@ -54,10 +52,10 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
         table(&a, nf);
     }
     if let Some(dir) = opts.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("--out: cannot create {}", dir.display()))?;
-        write_outputs(dir, &scene, nf, &a.orders, a.range, a.per_unit)
-            .with_context(|| format!("--out: cannot write into {}", dir.display()))?;
+        let mut warnings = Vec::new();
+        hbal::render::write_modes_files(dir, &scene, &a, &mut warnings)
+            .map_err(|e| super::failure(e, &scene.file))?;
+        super::print_warnings(&warnings);
         if !as_json {
             say!("  wrote modes.csv, campbell.svg to {}", dir.display());
         }
@@ -110,96 +108,4 @@ fn table(a: &ModesAnalysis, nf: &NaturalFrequencies) {
             c.mode
         );
     }
-}
-
-/// `modes.csv` (frequencies and shapes) and `campbell.svg`.
-pub(crate) fn write_outputs(
-    dir: &Path,
-    scene: &Scene,
-    nf: &NaturalFrequencies,
-    orders: &[f64],
-    (from, to): (f64, f64),
-    per_unit: f64,
-) -> anyhow::Result<()> {
-    let mut w = csv::Writer::from_path(dir.join("modes.csv"))?;
-    let mut header = vec![
-        "mode".to_string(),
-        "mean_hz".into(),
-        "lower_hz".into(),
-        "upper_hz".into(),
-    ];
-    header.extend(scene.model.dof_names().iter().cloned());
-    w.write_record(&header)?;
-    for (i, f) in nf.mean.iter().enumerate() {
-        let mut row = vec![
-            (i + 1).to_string(),
-            format!("{f:e}"),
-            format!("{:e}", nf.lower.get(i).copied().unwrap_or(f64::NAN)),
-            format!("{:e}", nf.upper.get(i).copied().unwrap_or(f64::NAN)),
-        ];
-        row.extend(nf.shapes.column(i).iter().map(|v| format!("{v:e}")));
-        w.write_record(&row)?;
-    }
-    w.flush()?;
-    // The diagram up to the highest order line's frequency at `to` (and at least the lowest
-    // elastic mode).
-    let top_order = orders.iter().cloned().fold(0.0, f64::max);
-    let f_top = (top_order * to * per_unit / TAU).max(nf.mean.iter().cloned().fold(0.0, f64::min));
-    // Natural frequencies black (bounds dashed: one-tooth red, two-tooth blue), one legend
-    // entry each; order lines in the other colours; the critical speeds as markers.
-    let mut series = Vec::new();
-    let (mut first_mode, mut first_bound) = (true, [true, true]);
-    let shown = nf
-        .mean
-        .iter()
-        .enumerate()
-        .filter(|(_, f)| **f > 0.0 && **f <= 1.2 * f_top);
-    for (i, f) in shown {
-        let label = if std::mem::take(&mut first_mode) {
-            "natural frequency"
-        } else {
-            ""
-        };
-        series.push(Series::line(label, vec![(from, *f), (to, *f)]).with_color(0));
-        for (j, b) in [&nf.lower, &nf.upper].iter().enumerate() {
-            if let Some(&fb) = b.get(i) {
-                if (fb - f).abs() > 1e-9 * f {
-                    let l = if std::mem::take(&mut first_bound[j]) {
-                        ["one-tooth bound", "two-tooth bound"][j]
-                    } else {
-                        ""
-                    };
-                    series.push(Series::dashed(l, vec![(from, fb), (to, fb)]).with_color(1 + j));
-                }
-            }
-        }
-    }
-    for (k, o) in orders.iter().enumerate() {
-        let f = |s: f64| o * s * per_unit / TAU;
-        series.push(
-            Series::line(format!("order {o}"), vec![(from, f(from)), (to, f(to))])
-                .with_color(3 + k % 7),
-        );
-    }
-    let crossings: Vec<(f64, f64)> = orders
-        .iter()
-        .flat_map(|&o| {
-            nf.mean
-                .iter()
-                .filter(|f| **f > 0.0)
-                .map(move |&f| (TAU * f / (o * per_unit), f))
-        })
-        .filter(|&(s, _)| s >= from && s <= to)
-        .collect();
-    if !crossings.is_empty() {
-        series.push(Series::markers("critical speed", crossings).with_color(1));
-    }
-    line_plot(
-        &dir.join("campbell.svg"),
-        &format!("Campbell diagram: {}", scene.file),
-        &Axis::linear(format!("speed ({})", scene.speed_unit)),
-        &Axis::linear("frequency (Hz)"),
-        &series,
-    )
-    .map_err(|e| anyhow::anyhow!("plot: {e}"))
 }

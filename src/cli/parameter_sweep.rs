@@ -55,13 +55,11 @@ pub(crate) fn parameter_sweep(
         let mut files = vec!["branch.csv".to_string()];
         if hbal::scene::set_parameter(&mut first, name, from).is_ok() {
             if let Ok(scene) = Scene::from_value(first, &file) {
-                for dof in scene.model.dof_names() {
-                    super::file_name_part(dof, "DOF")?;
-                    files.push(format!("parameter_response_{dof}.svg"));
-                }
+                files = hbal::render::parameter_sweep_files(scene.model.dof_names())
+                    .map_err(|e| super::failure(e, &file))?;
             }
         }
-        super::prepare_out(dir, &files)?;
+        hbal::render::prepare_out(dir, &files).map_err(|e| super::failure(e, &file))?;
     }
     let bar = super::progress::Progress::new("parameter sweep", opts.json);
     let a = hbal::analysis::parameter_sweep(&doc, &file, &settings, &mut &bar)
@@ -83,7 +81,10 @@ pub(crate) fn parameter_sweep(
         summary(&a);
     }
     if let Some(dir) = opts.out {
-        write_files(dir, &a)?;
+        let mut warnings = Vec::new();
+        hbal::render::write_parameter_sweep_files(dir, &a, &mut warnings)
+            .map_err(|e| super::failure(e, &file))?;
+        super::print_warnings(&warnings);
     }
     if a.exit_code() != 0 {
         eprintln!("error: {file}: the sweep stopped: {}", a.branch.stop);
@@ -112,29 +113,4 @@ fn summary(a: &ParameterSweepAnalysis) {
             p.parameter
         );
     }
-}
-
-/// branch.csv and one parameter-response plot per reported DOF.
-fn write_files(dir: &Path, a: &ParameterSweepAnalysis) -> anyhow::Result<()> {
-    let (branch, name) = (&a.branch, &a.settings.parameter);
-    std::fs::create_dir_all(dir)?;
-    let csv =
-        hbal::report::branch_csv_of_dofs(branch, a.fundamental_order, &a.reported, name, |p| p);
-    std::fs::write(dir.join("branch.csv"), csv)?;
-    if branch.points.len() < 2 {
-        return Ok(());
-    }
-    for &i in &a.reported {
-        let dof = &branch.dofs[i];
-        hbal::report::branch_plot(
-            &dir.join(format!("parameter_response_{dof}.svg")),
-            branch,
-            i,
-            &format!("Response of {dof} against {name}"),
-            name,
-            |p| p,
-        )
-        .unwrap_or_else(super::plot_warning);
-    }
-    Ok(())
 }

@@ -3,8 +3,7 @@
 //! summary or one JSON object (the analysis's serde form), and optionally write
 //! harmonics.csv, time_series.csv and SVG plots.
 
-use super::solve_files::{write_outputs, OutputLabel};
-use super::{element_report, load, start, Failure, SolverArgs};
+use super::{load, start, Failure, SolverArgs};
 use anyhow::Context;
 use hbal::analysis::{SolveAnalysis, SolveNote, SolveSettings, StabilityOutcome};
 use hbal::scene::Scene;
@@ -31,7 +30,8 @@ pub(crate) fn solve(path: &Path, args: &SolverArgs, opts: SolveOptions) -> Resul
         return super::torus_solve::solve(&scene, as_json, opts.out);
     }
     if let Some(dir) = opts.out {
-        super::prepare_out(dir, &super::solve_files())?;
+        hbal::render::prepare_out(dir, &hbal::render::solve_files())
+            .map_err(|e| super::failure(e, &scene.file))?;
     }
     let start = opts.start.map(|p| start::read(p, &scene)).transpose()?;
     if let (Some(file), Some(s)) = (opts.start, &start) {
@@ -83,43 +83,12 @@ fn start_notes(scene: &Scene, file: &Path, s: &hbal::analysis::StartRecord) {
     }
 }
 
-/// The files of `--out DIR`.
-pub(crate) fn write_files(
-    scene: &Scene,
-    a: &SolveAnalysis,
-    dir: &Path,
-    as_json: bool,
-) -> Result<(), Failure> {
-    let order =
-        |k| hbal::analysis::order_of(k, scene.fundamental_order, a.solution.basis().subharmonic());
-    // Files of an unconverged iterate say so in their names and plot titles.
-    let prefix = if a.solution.is_converged() {
-        ""
-    } else {
-        "not_converged_"
-    };
-    let label = OutputLabel {
-        title: format!(
-            "{} at {} {}{}",
-            scene.file,
-            super::speed_text(a.solution.basis().omega() / scene.omega_per_speed),
-            scene.speed_unit,
-            if a.solution.is_converged() {
-                String::new()
-            } else {
-                format!(" - NOT CONVERGED ({})", a.solution.termination)
-            }
-        ),
-        prefix,
-    };
-    let series = a.exact.as_ref().and_then(super::solve_exact::time_series);
-    let mut written = write_outputs(dir, &a.solution, &label, order, series)
-        .with_context(|| format!("--out: cannot write {}", dir.display()))?;
-    if let Ok(e) = &a.elements {
-        element_report::write_csv(&dir.join(format!("{prefix}elements.csv")), e, order)
-            .with_context(|| format!("--out: cannot write {}", dir.display()))?;
-        written.insert(1, format!("{prefix}elements.csv"));
-    }
+/// The files of `--out DIR` ([`hbal::render::write_solve_files`]), and what was written.
+fn write_files(scene: &Scene, a: &SolveAnalysis, dir: &Path, as_json: bool) -> Result<(), Failure> {
+    let mut warnings = Vec::new();
+    let written = hbal::render::write_solve_files(scene, a, dir, &mut warnings)
+        .map_err(|e| super::failure(e, &scene.file))?;
+    super::print_warnings(&warnings);
     if !as_json {
         say!("  wrote {} to {}", written.join(", "), dir.display());
     }

@@ -1,9 +1,8 @@
 //! `hbal sweep` (without `--parameter`): parses the options, runs the library's speed sweep
 //! ([`hbal::analysis::sweep`]) with the progress bar, and renders its result as JSON, as the
-//! summary ([`super::sweep_text`]) and as files in `--out` ([`super::sweep_files`]).
+//! summary ([`super::sweep_text`]) and as files in `--out` ([`hbal::render::write_sweep_files`]).
 
 use super::{load, start, Failure, SolverArgs};
-use anyhow::Context;
 use hbal::analysis::{SweepAnalysis, SweepSettings, SweepStart};
 use std::path::Path;
 
@@ -86,16 +85,8 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
     let settings = opts.settings(args, start);
     hbal::analysis::check_sweep(&scene, &settings).map_err(|e| super::failure(e, &scene.file))?;
     if let Some(dir) = opts.out {
-        for dof in scene.model.dof_names() {
-            super::file_name_part(dof, "DOF")?;
-        }
-        let reported = hbal::analysis::reported_dofs(&scene.model, opts.dofs)
+        hbal::render::prepare_sweep_out(dir, &scene, opts.dofs)
             .map_err(|e| super::failure(e, &scene.file))?;
-        let names = scene.model.dof_names();
-        super::prepare_out(
-            dir,
-            &super::sweep_files(reported.iter().map(|&i| &names[i])),
-        )?;
     }
     let bar = super::progress::Progress::new("sweep", as_json);
     let analysis = hbal::analysis::sweep(&scene, &settings, &mut &bar)
@@ -107,8 +98,10 @@ pub(crate) fn sweep(path: &Path, args: &SolverArgs, opts: SweepOptions) -> Resul
         super::sweep_text::print(&scene, &analysis, opts.out.is_some());
     }
     if let Some(dir) = opts.out {
-        super::sweep_files::write(dir, &scene, &analysis)
-            .with_context(|| format!("--out: cannot write into {}", dir.display()))?;
+        let mut warnings = Vec::new();
+        hbal::render::write_sweep_files(dir, &scene, &analysis, &mut warnings)
+            .map_err(|e| super::failure(e, &scene.file))?;
+        super::print_warnings(&warnings);
     }
     print_messages(&analysis);
     Ok(analysis.exit_code())

@@ -4,9 +4,7 @@
 //! line of every DOF, element coordinate and element force) and `spectrum.svg`.
 
 use super::Failure;
-use anyhow::Context;
 use hbal::analysis::{Spectrum, TorusSolveAnalysis, TorusSolveSettings};
-use hbal::report::{line_plot, Axis, Series};
 use hbal::scene::Scene;
 use std::path::Path;
 
@@ -27,7 +25,8 @@ pub(crate) fn refuse_flags(given: &[(&str, bool)]) -> Result<(), Failure> {
 /// Solves, prints and writes; the exit code of the analysis.
 pub(crate) fn solve(scene: &Scene, json: bool, out: Option<&Path>) -> Result<u8, Failure> {
     if let Some(dir) = out {
-        super::prepare_out(dir, &["lines.csv".into(), "spectrum.svg".into()])?;
+        hbal::render::prepare_out(dir, &hbal::render::torus_solve_files())
+            .map_err(|e| super::failure(e, &scene.file))?;
     }
     let a = hbal::analysis::torus_solve(scene, &TorusSolveSettings::default())
         .map_err(|e| super::failure(e, &scene.file))?;
@@ -37,7 +36,10 @@ pub(crate) fn solve(scene: &Scene, json: bool, out: Option<&Path>) -> Result<u8,
         print(scene, &a);
     }
     if let Some(dir) = out {
-        write_files(dir, scene, &a)?;
+        let mut warnings = Vec::new();
+        hbal::render::write_torus_solve_files(dir, scene, &a, &mut warnings)
+            .map_err(|e| super::failure(e, &scene.file))?;
+        super::print_warnings(&warnings);
         if !json {
             say!("  wrote lines.csv, spectrum.svg to {}", dir.display());
         }
@@ -55,18 +57,6 @@ pub(crate) fn solve(scene: &Scene, json: bool, out: Option<&Path>) -> Result<u8,
         );
     }
     Ok(a.exit_code())
-}
-
-/// `lines.csv` and `spectrum.svg` into `dir`.
-pub(crate) fn write_files(
-    dir: &Path,
-    scene: &Scene,
-    a: &TorusSolveAnalysis,
-) -> Result<(), Failure> {
-    write_lines(&dir.join("lines.csv"), a)
-        .with_context(|| format!("--out: cannot write {}", dir.display()))?;
-    plot_spectrum(&dir.join("spectrum.svg"), scene, a);
-    Ok(())
 }
 
 /// The summary.
@@ -158,96 +148,4 @@ fn print_spectrum(what: &str, s: &Spectrum) {
             l.label
         );
     }
-}
-
-/// `lines.csv`: every line of every element coordinate and DOF.
-fn write_lines(path: &Path, a: &TorusSolveAnalysis) -> anyhow::Result<()> {
-    let mut w = csv::Writer::from_path(path)?;
-    let mut header = vec!["what".to_string(), "name".to_string(), "line".to_string()];
-    header.extend(a.bases.iter().map(|b| format!("k_{}", b.name)));
-    header.extend(["order", "hz", "amplitude", "phase_deg"].map(String::from));
-    w.write_record(&header)?;
-    let sol = &a.solution;
-    for (what, name, q) in quantities(a) {
-        for (j, (k, q)) in sol.indices.iter().zip(&q).enumerate() {
-            let order = sol.order(j);
-            let mut row = vec![
-                what.to_string(),
-                name.clone(),
-                hbal::analysis::line_label(&sol.bases, k),
-            ];
-            row.extend(k.iter().map(|k| k.to_string()));
-            row.push(format!("{order:e}"));
-            row.push(format!("{:e}", order * sol.omega / std::f64::consts::TAU));
-            row.push(format!("{:e}", q.norm()));
-            row.push(format!("{:e}", q.arg().to_degrees()));
-            w.write_record(&row)?;
-        }
-    }
-    Ok(w.flush()?)
-}
-
-/// Every DOF's and element coordinate's lines, line by line.
-fn quantities(
-    a: &TorusSolveAnalysis,
-) -> Vec<(&'static str, String, Vec<hbal::num_complex::Complex64>)> {
-    let sol = &a.solution;
-    let n = sol.n_dofs();
-    let line = |j: usize, i: usize| {
-        let (re, im) = sol.harmonics[j * n + i];
-        hbal::num_complex::Complex64::new(re, im)
-    };
-    let mut out: Vec<_> = (0..n)
-        .map(|i| {
-            (
-                "dof",
-                sol.dofs[i].clone(),
-                (0..sol.indices.len()).map(|j| line(j, i)).collect(),
-            )
-        })
-        .collect();
-    out.extend(
-        a.element_lines
-            .iter()
-            .map(|(name, q)| ("element", name.clone(), q.clone())),
-    );
-    out.extend(
-        a.force_lines
-            .iter()
-            .map(|(name, q)| ("force", name.clone(), q.clone())),
-    );
-    out
-}
-
-/// `spectrum.svg`: every element coordinate's lines over their order (log amplitude).
-fn plot_spectrum(path: &Path, scene: &Scene, a: &TorusSolveAnalysis) {
-    let series: Vec<Series> = a
-        .element_lines
-        .iter()
-        .map(|(name, q)| {
-            let mut points: Vec<(f64, f64)> = (1..q.len())
-                .map(|j| (a.solution.order(j), q[j].norm()))
-                .filter(|p| p.1 > 0.0)
-                .collect();
-            points.sort_by(|x, y| x.0.total_cmp(&y.0));
-            Series::markers(name.clone(), points)
-        })
-        .collect();
-    if series.iter().all(|s| s.points.is_empty()) {
-        return;
-    }
-    let title = format!(
-        "Lines of the element coordinates at {} {}: {}",
-        super::speed_text(a.speed),
-        a.speed_unit,
-        scene.file
-    );
-    line_plot(
-        path,
-        &title,
-        &Axis::linear(format!("order of the speed ({})", a.speed_unit)),
-        &Axis::log("amplitude"),
-        &series,
-    )
-    .unwrap_or_else(super::plot_warning);
 }

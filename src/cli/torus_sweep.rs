@@ -7,7 +7,6 @@ use super::progress::Progress;
 use super::Failure;
 use anyhow::Context;
 use hbal::analysis::{TorusSweepAnalysis, TorusSweepSettings};
-use hbal::report::{line_plot, waterfall_plot, Axis, Series, Slice, Waterfall};
 use hbal::scene::Scene;
 use std::path::Path;
 
@@ -56,27 +55,11 @@ pub(crate) fn sweep(scene: &Scene, opts: TorusSweepOptions) -> Result<u8, Failur
 
 /// Checks the options, sweeps (a progress bar unless `json`) and writes the files of `out`.
 pub(crate) fn run(scene: &Scene, opts: TorusSweepOptions) -> Result<TorusSweepAnalysis, Failure> {
-    let elements = scene.model.elements();
-    let shown = match opts.output {
-        None => elements.first().map(|e| e.name().to_string()),
-        Some(name) if elements.iter().any(|e| e.name() == name) => Some(name.to_string()),
-        Some(name) => {
-            let names: Vec<&str> = elements.iter().map(|e| e.name()).collect();
-            return Err(anyhow::anyhow!(
-                "--output `{name}`: on the torus the order cuts are those of an element coordinate (the scene has: {})",
-                names.join(", ")
-            )
-            .into());
-        }
-    };
+    let shown = hbal::render::torus_shown(scene, opts.output)
+        .map_err(|e| super::failure(e, &scene.file))?;
     if let Some(dir) = opts.out {
-        let files = [
-            "points.csv",
-            "order_cuts.csv",
-            "order_cuts.svg",
-            "waterfall.svg",
-        ];
-        super::prepare_out(dir, &files.map(String::from))?;
+        hbal::render::prepare_out(dir, &hbal::render::torus_sweep_files())
+            .map_err(|e| super::failure(e, &scene.file))?;
     }
     let settings = TorusSweepSettings {
         from: opts.from,
@@ -88,8 +71,10 @@ pub(crate) fn run(scene: &Scene, opts: TorusSweepOptions) -> Result<TorusSweepAn
         .map_err(|e| super::failure(e, &scene.file))?;
     progress.finish();
     if let Some(dir) = opts.out {
-        write_files(dir, scene, &a, shown.as_deref())
-            .with_context(|| format!("--out: cannot write {}", dir.display()))?;
+        let mut warnings = Vec::new();
+        hbal::render::write_torus_sweep_files(dir, scene, &a, shown.as_deref(), &mut warnings)
+            .map_err(|e| super::failure(e, &scene.file))?;
+        super::print_warnings(&warnings);
     }
     Ok(a)
 }
@@ -144,136 +129,4 @@ fn print(scene: &Scene, a: &TorusSweepAnalysis) {
             super::speed_text(c.peak.1)
         );
     }
-}
-
-fn write_files(
-    dir: &Path,
-    scene: &Scene,
-    a: &TorusSweepAnalysis,
-    shown: Option<&str>,
-) -> anyhow::Result<()> {
-    let unit = &a.speed_unit;
-    let mut w = csv::Writer::from_path(dir.join("points.csv"))?;
-    let mut header = vec![
-        format!("speed_{unit}"),
-        "converged".into(),
-        "relative_residual".into(),
-        "newton_steps".into(),
-    ];
-    header.extend(a.bases.iter().map(|b| format!("truncation_{}", b.name)));
-    w.write_record(&header)?;
-    for p in &a.points {
-        let mut row = vec![
-            format!("{:e}", p.speed),
-            p.converged.to_string(),
-            format!("{:e}", p.relative_residual),
-            p.iterations.to_string(),
-        ];
-        row.extend(
-            p.estimates
-                .iter()
-                .map(|e| e.map_or(String::new(), |e| format!("{e:e}"))),
-        );
-        w.write_record(&row)?;
-    }
-    w.flush()?;
-    let mut w = csv::Writer::from_path(dir.join("order_cuts.csv"))?;
-    w.write_record([
-        format!("speed_{unit}"),
-        "element".into(),
-        "line".into(),
-        "order".into(),
-        "amplitude".into(),
-        "converged".into(),
-    ])?;
-    for c in &a.order_cuts {
-        for (p, amp) in a.points.iter().zip(&c.amplitudes) {
-            w.write_record([
-                format!("{:e}", p.speed),
-                c.element.clone(),
-                c.label.clone(),
-                format!("{:e}", c.order),
-                format!("{amp:e}"),
-                p.converged.to_string(),
-            ])?;
-        }
-    }
-    w.flush()?;
-    let Some(name) = shown else { return Ok(()) };
-    if a.points.len() < 2 {
-        return Ok(());
-    }
-    let speed_axis = format!("speed ({unit})");
-    let series: Vec<Series> = a
-        .order_cuts
-        .iter()
-        .filter(|c| c.element == name)
-        .map(|c| {
-            let points = a
-                .points
-                .iter()
-                .zip(&c.amplitudes)
-                .map(|(p, &x)| (p.speed, x))
-                .collect();
-            Series::line(
-                format!("{} (order {})", c.label, super::speed_text(c.order)),
-                points,
-            )
-        })
-        .collect();
-    let title = |kind: &str| format!("{kind} of the coordinate of `{name}`: {}", scene.file);
-    line_plot(
-        &dir.join("order_cuts.svg"),
-        &title("Order cuts"),
-        &Axis::linear(&speed_axis),
-        &Axis::auto("amplitude"),
-        &series,
-    )
-    .unwrap_or_else(super::plot_warning);
-    waterfall(dir, scene, a, name, &title("Waterfall"), &speed_axis);
-    Ok(())
-}
-
-/// `waterfall.svg`: every line of the element's coordinate at every point, at its order; the
-/// mesh harmonics (lines of one base) in colour, their sidebands grey.
-fn waterfall(
-    dir: &Path,
-    scene: &Scene,
-    a: &TorusSweepAnalysis,
-    name: &str,
-    title: &str,
-    speed_axis: &str,
-) {
-    let Some(e) = scene.model.elements().iter().find(|e| e.name() == name) else {
-        return;
-    };
-    let slices: Vec<Slice> = a
-        .solutions
-        .iter()
-        .map(|s| {
-            let q = s.coordinate_lines(e.weights());
-            Slice {
-                speed: s.omega / scene.torus.as_ref().map_or(1.0, |p| p.rad_s_per_speed),
-                amplitudes: (1..q.len()).map(|j| (s.order(j), q[j].norm())).collect(),
-            }
-        })
-        .collect();
-    let highlight: Vec<f64> = a
-        .solutions
-        .first()
-        .map(|s| {
-            (1..s.indices.len())
-                .filter(|&j| s.indices[j].iter().filter(|&&k| k != 0).count() == 1)
-                .map(|j| s.order(j))
-                .collect()
-        })
-        .unwrap_or_default();
-    let plot = Waterfall {
-        title,
-        speed_label: speed_axis,
-        unit: "m",
-        range_db: 60.0,
-        highlight: &highlight,
-    };
-    waterfall_plot(&dir.join("waterfall.svg"), &plot, &slices).unwrap_or_else(super::plot_warning);
 }

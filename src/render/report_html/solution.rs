@@ -2,8 +2,8 @@
 //! time series and spectrum, the DOF and element tables.
 
 use super::{figure, num, percent, result, Inputs};
-use hbal::analysis::{order_of, SolveAnalysis, StabilityOutcome};
-use hbal::report::{significant, ElementOutput, HtmlReport};
+use crate::analysis::{order_of, SolveAnalysis, StabilityOutcome};
+use crate::report::{significant, ElementOutput, HtmlReport};
 
 /// Most rows of the DOF table (the DOFs with the largest max |q| of a larger model).
 const MAX_DOF_ROWS: usize = 40;
@@ -12,7 +12,7 @@ pub(super) fn solve_section(r: &mut HtmlReport, i: &Inputs) {
     let scene = i.scene;
     r.heading(&format!(
         "Periodic solution at {} {}",
-        crate::cli::speed_text(scene.basis.omega() / scene.omega_per_speed),
+        crate::render::speed_text(scene.basis.omega() / scene.omega_per_speed),
         scene.speed_unit
     ));
     let Some(a) = result(r, i.solved, "solution") else {
@@ -67,7 +67,7 @@ fn estimate_text(a: &SolveAnalysis) -> String {
             significant(e.kept_harmonics, 2),
             e.reference_harmonics,
             match a.auto.as_ref().map(|r| r.settings.control) {
-                Some(hbal::solve::Control::Harmonics) =>
+                Some(crate::solve::Control::Harmonics) =>
                     "; automatic harmonics on the harmonics 0..H",
                 Some(_) => "; automatic harmonics on the periodic solution",
                 None => "",
@@ -96,7 +96,7 @@ fn stability_text(s: &StabilityOutcome) -> String {
 
 /// Every DOF's max |q| and the amplitude of each excitation order.
 fn dof_table(r: &mut HtmlReport, i: &Inputs, a: &SolveAnalysis) {
-    let orders: Vec<f64> = hbal::analysis::excitation_orders(i.scene, &i.scene.basis)
+    let orders: Vec<f64> = crate::analysis::excitation_orders(i.scene, &i.scene.basis)
         .into_iter()
         .map(|o| o.0)
         .collect();

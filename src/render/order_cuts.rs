@@ -1,16 +1,15 @@
 //! Order cuts of a speed sweep: for every point of the branch, the amplitude and phase of each
 //! excitation order (the scene's load orders and mesh orders, as multiples of the reference
-//! speed) of the reported DOFs (`--dofs`, [`super::dof_selection`]) and every element
+//! speed) of the reported DOFs (`--dofs`, [`crate::analysis::reported_dofs`]) and every element
 //! coordinate, and the fraction of the
 //! period each contact spends open: `order_cuts.csv`; for one chosen output (`--output`, by
 //! default the first gear stage's transmission error, else the DOF that moves most) the order
 //! cuts `order_cuts.svg` and the waterfall of its spectrum over speed `waterfall.svg`.
 
-use hbal::analysis::Shown;
-use hbal::continuation::{Branch, BranchPoint};
-use hbal::report::{line_plot, waterfall_plot, Axis, ElementOutput, Series, Slice, Waterfall};
-use hbal::scene::Scene;
-use hbal::HarmonicBasis;
+use crate::analysis::{Shown, SweepAnalysis};
+use crate::continuation::{Branch, BranchPoint};
+use crate::report::{line_plot, waterfall_plot, Axis, ElementOutput, Series, Slice, Waterfall};
+use crate::scene::Scene;
 use std::path::Path;
 
 /// What `shown` is on `branch`: a function from (point, its element outputs, harmonic k) to
@@ -84,35 +83,27 @@ fn shown_amplitude<'a>(
     }
 }
 
-/// What the order cuts show: the DOFs with columns in `order_cuts.csv` (indices into
-/// `branch.dofs`; every element has its own) and the output of the plots.
-pub(crate) struct Shows<'a> {
-    pub(crate) dofs: &'a [usize],
-    pub(crate) plotted: Shown,
-}
-
-/// Writes `order_cuts.csv`, `order_cuts.svg` and `waterfall.svg` for `branch` (computed on
-/// `basis`) into `dir`: the columns and plots of `shows`.
-pub(crate) fn write(
+/// Writes `order_cuts.csv`, `order_cuts.svg` and `waterfall.svg` of the sweep `a` into `dir`:
+/// columns for the reported DOFs (and every element), the plots of the shown output.
+pub(super) fn write(
     dir: &Path,
     scene: &Scene,
-    branch: &Branch,
-    basis: &HarmonicBasis,
-    outputs: &[Vec<ElementOutput>],
-    shows: Shows,
-    speed: impl Fn(f64) -> f64,
+    a: &SweepAnalysis,
+    warnings: &mut Vec<String>,
 ) -> anyhow::Result<()> {
-    let orders = hbal::analysis::excitation_orders(scene, basis);
+    let (branch, basis, outputs) = (&a.branch, &a.basis, &a.outputs[..]);
+    let speed = |w: f64| a.speed(w);
+    let orders = crate::analysis::excitation_orders(scene, basis);
     csv_of(
         &dir.join("order_cuts.csv"),
         scene,
         branch,
         outputs,
-        shows.dofs,
+        &a.reported,
         &orders,
-        &speed,
+        speed,
     )?;
-    let (amplitude, what, unit) = shown_amplitude(scene, branch, shows.plotted);
+    let (amplitude, what, unit) = shown_amplitude(scene, branch, a.shown);
     let title = |kind: &str| format!("{kind} of the {what}: {}", scene.file);
     let speed_axis = format!("speed ({})", scene.speed_unit);
     let points = || branch.points.iter().zip(outputs);
@@ -128,20 +119,20 @@ pub(crate) fn write(
         .collect();
     if !series.is_empty() {
         let y = Axis::auto(format!("amplitude ({unit})"));
-        line_plot(
+        let plot = line_plot(
             &dir.join("order_cuts.svg"),
             &title("Order cuts"),
             &Axis::linear(&speed_axis),
             &y,
             &series,
-        )
-        .unwrap_or_else(super::plot_warning);
+        );
+        super::plot_warning(warnings, plot);
     }
     // The waterfall's orders: up to twice the highest excitation harmonic (at least 4).
     let top_k = orders.iter().map(|o| o.1).max().unwrap_or(1);
     let stems = (2 * top_k).max(4).min(branch.harmonics);
     let order_of =
-        |k: usize| super::element_report::order_of(k, scene.fundamental_order, basis.subharmonic());
+        |k: usize| crate::analysis::order_of(k, scene.fundamental_order, basis.subharmonic());
     let slices: Vec<Slice> = points()
         .map(|(p, out)| Slice {
             speed: speed(p.omega),
@@ -159,8 +150,8 @@ pub(crate) fn write(
             range_db: 60.0,
             highlight: &highlight,
         };
-        waterfall_plot(&dir.join("waterfall.svg"), &waterfall, &slices)
-            .unwrap_or_else(super::plot_warning);
+        let plot = waterfall_plot(&dir.join("waterfall.svg"), &waterfall, &slices);
+        super::plot_warning(warnings, plot);
     }
     Ok(())
 }

@@ -7,19 +7,19 @@ mod run_up;
 mod solution;
 
 use super::report::Part;
-use hbal::analysis::{ModesAnalysis, SolveAnalysis, SweepAnalysis};
-use hbal::report::{significant, HtmlReport};
-use hbal::scene::Scene;
+use crate::analysis::{ModesAnalysis, SolveAnalysis, SweepAnalysis};
+use crate::report::{significant, HtmlReport};
+use crate::scene::Scene;
 use std::path::Path;
 
 /// Everything the page shows.
-pub(crate) struct Inputs<'a> {
-    pub(crate) scene: &'a Scene,
-    pub(crate) scene_text: &'a str,
-    pub(crate) dir: &'a Path,
-    pub(crate) solved: &'a Part<SolveAnalysis>,
-    pub(crate) swept: Option<&'a Part<SweepAnalysis>>,
-    pub(crate) moded: &'a Part<ModesAnalysis>,
+pub(super) struct Inputs<'a> {
+    pub(super) scene: &'a Scene,
+    pub(super) scene_text: &'a str,
+    pub(super) dir: &'a Path,
+    pub(super) solved: &'a Part<SolveAnalysis>,
+    pub(super) swept: Option<&'a Part<SweepAnalysis>>,
+    pub(super) moded: &'a Part<ModesAnalysis>,
 }
 
 /// A number with 4 significant digits, `–` where there is none (or it is not finite).
@@ -57,7 +57,7 @@ fn figure(r: &mut HtmlReport, dir: &Path, file: &str, caption: &str) {
     }
 }
 
-pub(crate) fn build(i: &Inputs) -> String {
+pub(super) fn build(i: &Inputs) -> String {
     let scene = i.scene;
     let unit = scene.speed_unit;
     let mut r = HtmlReport::new(&format!("hbal report: {}", scene.file));

@@ -2,10 +2,10 @@
 //! waterfall and frequency responses.
 
 use super::{figure, num, percent, result, Inputs};
-use crate::cli::report::Part;
-use hbal::analysis::SweepAnalysis;
-use hbal::continuation::BranchStop;
-use hbal::report::{significant, HtmlReport};
+use crate::analysis::SweepAnalysis;
+use crate::continuation::BranchStop;
+use crate::render::Part;
+use crate::report::{significant, HtmlReport};
 
 /// Frequency-response plots shown (of the first DOFs the sweep wrote plots of, its reported
 /// DOFs; every one of those is in `sweep/`).
@@ -19,7 +19,7 @@ pub(super) fn sweep_section(r: &mut HtmlReport, i: &Inputs, part: &Part<SweepAna
     };
     let points = &a.branch.points;
     let unstable = points.iter().filter(|p| p.stable() == Some(false)).count();
-    let largest = |f: fn(&hbal::continuation::BranchPoint) -> Option<f64>| {
+    let largest = |f: fn(&crate::continuation::BranchPoint) -> Option<f64>| {
         points.iter().filter_map(f).fold(0.0f64, f64::max)
     };
     let worst = largest(|p| p.error_estimate);

@@ -2,7 +2,7 @@
 //! the Campbell diagram.
 
 use super::{figure, num, result, Inputs};
-use hbal::report::HtmlReport;
+use crate::report::HtmlReport;
 
 pub(super) fn modes_section(r: &mut HtmlReport, i: &Inputs) {
     let unit = i.scene.speed_unit;

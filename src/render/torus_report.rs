@@ -4,11 +4,14 @@
 //! cuts, waterfall (sidebands included) and the points that did not converge. The parts' files
 //! go to `DIR/solve` and `DIR/sweep` as `hbal solve` and `hbal sweep` write them.
 
-use super::report::ReportOptions;
-use super::Failure;
-use hbal::analysis::{Spectrum, TorusSolveAnalysis, TorusSolveSettings, TorusSweepAnalysis};
-use hbal::report::HtmlReport;
-use hbal::scene::Scene;
+use super::report::{options, Report, ReportParts, ReportSettings};
+use super::{prepare_out, speed_text};
+use crate::analysis::{Observer, Spectrum, TorusSolveAnalysis, TorusSolveSettings};
+use crate::analysis::{TorusSweepAnalysis, TorusSweepSettings};
+use crate::error::Result;
+use crate::report::HtmlReport;
+use crate::scene::Scene;
+use std::path::Path;
 
 /// Points of the report's run-up.
 const RUN_UP_POINTS: usize = 101;
@@ -16,44 +19,79 @@ const RUN_UP_POINTS: usize = 101;
 /// Lines per element in the report's tables.
 const TABLE_LINES: usize = 8;
 
-pub(crate) fn report(scene: &Scene, scene_text: &str, opts: &ReportOptions) -> Result<u8, Failure> {
-    if opts.from.is_some() && opts.to.is_none() {
-        return Err(anyhow::anyhow!("--from needs --to (the run-up's end speed)").into());
+/// The report of a torus scene ([`super::report`]).
+pub(super) fn report(
+    scene: &Scene,
+    scene_text: &str,
+    settings: &ReportSettings,
+    dir: &Path,
+    observer: &mut dyn Observer,
+) -> Result<Report> {
+    let shown = match settings.to {
+        Some(_) => super::torus_shown(scene, settings.output.as_deref())?,
+        None if settings.output.is_some() => {
+            return Err(options("--output", "chooses the run-up's plots: give --to"))
+        }
+        None => None,
+    };
+    prepare_out(dir, &["report.html".to_string()])?;
+    prepare_out(&dir.join("solve"), &super::torus_solve_files())?;
+    if settings.to.is_some() {
+        prepare_out(&dir.join("sweep"), &super::torus_sweep_files())?;
     }
-    let dir = opts.out;
-    super::prepare_out(dir, &["report.html".to_string()])?;
-    super::prepare_out(
-        &dir.join("solve"),
-        &["lines.csv".into(), "spectrum.svg".into()],
-    )?;
-    eprintln!(
-        "report: solving {} at its speed on several base frequencies",
+    let mut warnings = Vec::new();
+    observer.stage(&format!(
+        "solving {} at its speed on several base frequencies",
         scene.file
-    );
-    let solved = hbal::analysis::torus_solve(scene, &TorusSolveSettings::default())
-        .map_err(|e| super::failure(e, &scene.file))?;
-    super::torus_solve::write_files(&dir.join("solve"), scene, &solved)?;
-    let swept = match opts.to {
+    ));
+    let solved = crate::analysis::torus_solve(scene, &TorusSolveSettings::default())?;
+    super::write_torus_solve_files(&dir.join("solve"), scene, &solved, &mut warnings)?;
+    let swept = match settings.to {
         None => None,
         Some(to) => {
-            eprintln!(
-                "report: run-up to {} {}",
-                super::speed_text(to),
+            observer.stage(&format!(
+                "run-up to {} {}",
+                speed_text(to),
                 scene.speed_unit
-            );
-            let options = super::torus_sweep::TorusSweepOptions {
-                from: opts.from,
+            ));
+            let sweep = TorusSweepSettings {
+                from: settings.from,
                 to,
                 points: RUN_UP_POINTS,
-                json: true,
-                out: Some(&dir.join("sweep")),
-                output: opts.output,
             };
-            Some(super::torus_sweep::run(scene, options)?)
+            let a = crate::analysis::torus_sweep(scene, &sweep, observer)?;
+            let out = dir.join("sweep");
+            super::write_torus_sweep_files(&out, scene, &a, shown.as_deref(), &mut warnings)?;
+            Some(a)
         }
     };
+    let page = page(scene, scene_text, dir, &solved, swept.as_ref());
+    let file = dir.join("report.html");
+    std::fs::write(&file, page).map_err(|e| super::cannot_write(dir, e))?;
+    let exit_code = solved
+        .exit_code()
+        .max(swept.as_ref().map_or(0, |a| a.exit_code()));
+    Ok(Report {
+        file,
+        parts: ReportParts::Torus {
+            solved: Box::new(solved),
+            swept: swept.map(Box::new),
+        },
+        warnings,
+        exit_code,
+    })
+}
+
+/// The page.
+fn page(
+    scene: &Scene,
+    scene_text: &str,
+    dir: &Path,
+    solved: &TorusSolveAnalysis,
+    swept: Option<&TorusSweepAnalysis>,
+) -> String {
     let mut page = HtmlReport::new(&format!("hbal report: {}", scene.file));
-    overview(&mut page, scene, scene_text, &solved);
+    overview(&mut page, scene, scene_text, solved);
     for (coordinate, force) in solved.elements.iter().zip(&solved.forces) {
         page.heading(&format!("Element {}", coordinate.name));
         lines_table(
@@ -93,27 +131,17 @@ pub(crate) fn report(scene: &Scene, scene_text: &str, opts: &ReportOptions) -> R
         &dir.join("solve/spectrum.svg"),
         "Lines of the element coordinates",
     );
-    if let Some(a) = &swept {
+    if let Some(a) = swept {
         run_up(&mut page, dir, a);
     }
-    let file = dir.join("report.html");
-    std::fs::write(&file, page.finish())
-        .map_err(|e| anyhow::anyhow!("--out: cannot write {}: {e}", file.display()))?;
-    say!("wrote {}", file.display());
-    let code = solved
-        .exit_code()
-        .max(swept.as_ref().map_or(0, |a| a.exit_code()));
-    Ok(code)
+    page.finish()
 }
 
 fn overview(page: &mut HtmlReport, scene: &Scene, scene_text: &str, a: &TorusSolveAnalysis) {
     page.facts(&[
         ("scene", scene.file.clone()),
         ("description", scene.description.clone().unwrap_or_default()),
-        (
-            "speed",
-            format!("{} {}", super::speed_text(a.speed), a.speed_unit),
-        ),
+        ("speed", format!("{} {}", speed_text(a.speed), a.speed_unit)),
         ("basis", format!("several base frequencies: {}", a.why)),
         ("lines", a.lines.to_string()),
         ("relative residual", format!("{:.1e}", a.relative_residual)),
@@ -131,7 +159,7 @@ fn overview(page: &mut HtmlReport, scene: &Scene, scene_text: &str, a: &TorusSol
         .map(|b| {
             vec![
                 b.name.clone(),
-                super::speed_text(b.order),
+                speed_text(b.order),
                 format!("{:.2}", b.hz.unwrap_or(f64::NAN)),
                 b.cap.to_string(),
                 b.samples.to_string(),
@@ -144,7 +172,7 @@ fn overview(page: &mut HtmlReport, scene: &Scene, scene_text: &str, a: &TorusSol
         &["base", "order", "Hz", "cap", "grid", "truncation estimate"],
         &rows,
     );
-    let hbal::torus::TorusStability::NotComputed { reason } = &a.stability;
+    let crate::torus::TorusStability::NotComputed { reason } = &a.stability;
     page.paragraph(&format!("Stability: {reason}"));
     page.details("scene file", scene_text);
 }
@@ -161,7 +189,7 @@ fn lines_table(page: &mut HtmlReport, what: &str, s: &Spectrum) {
         .map(|l| {
             vec![
                 l.label.clone(),
-                super::speed_text(l.order),
+                speed_text(l.order),
                 format!("{:.2}", l.hz),
                 format!("{:.4e}", l.amplitude),
                 format!("{:.1}", l.phase.to_degrees()),
@@ -185,16 +213,11 @@ fn run_up(page: &mut HtmlReport, dir: &std::path::Path, a: &TorusSweepAnalysis) 
         .points
         .iter()
         .filter(|p| !p.converged)
-        .map(|p| {
-            vec![
-                super::speed_text(p.speed),
-                format!("{:.1e}", p.relative_residual),
-            ]
-        })
+        .map(|p| vec![speed_text(p.speed), format!("{:.1e}", p.relative_residual)])
         .chain(
             a.skipped
                 .iter()
-                .map(|(s, why)| vec![super::speed_text(*s), why.clone()]),
+                .map(|(s, why)| vec![speed_text(*s), why.clone()]),
         )
         .collect();
     if !rows.is_empty() {
@@ -213,9 +236,9 @@ fn run_up(page: &mut HtmlReport, dir: &std::path::Path, a: &TorusSweepAnalysis) 
             vec![
                 c.element.clone(),
                 c.label.clone(),
-                super::speed_text(c.order),
+                speed_text(c.order),
                 format!("{:.4e}", c.peak.0),
-                super::speed_text(c.peak.1),
+                speed_text(c.peak.1),
             ]
         })
         .collect();
