@@ -12,7 +12,8 @@ springs and force laws of your own, computed in the frequency domain by the Rust
 - :class:`Scene`: from a file, a string, a dict or matrices (:func:`scene_from_matrices`);
   Python force laws (:mod:`hbal.laws`).
 - :func:`solve`, :func:`sweep`, :func:`parameter_sweep`, :func:`modes`, :func:`compare`:
-  the command line's analyses, returning result objects (:mod:`hbal.results`).
+  the command line's analyses, returning result objects (:mod:`hbal.results`), with
+  ``out=DIR`` their files; :func:`report` the HTML report.
 - :mod:`hbal.study` and :mod:`hbal.variants`: many variants through any executor (a process
   pool, Dask), one tidy table written to Parquet as it goes, resumable;
   :func:`percentile_bands` and :func:`plot_bands` over it.
@@ -34,6 +35,7 @@ from .analyses import compare, modes, parameter_sweep, solve, sweep
 from .bands import percentile_bands, plot_bands
 from .laws import check_law
 from .model import scene_from_matrices
+from .report import ReportResult, report
 from .results import (
     CompareResult,
     ModesResult,
@@ -54,6 +56,7 @@ __all__ = [
     "ModesResult",
     "NumericalError",
     "ParameterSweepResult",
+    "ReportResult",
     "Result",
     "Scene",
     "SceneError",
@@ -68,6 +71,7 @@ __all__ = [
     "parameter_sweep",
     "percentile_bands",
     "plot_bands",
+    "report",
     "scene_from_matrices",
     "solve",
     "study",

@@ -45,6 +45,7 @@ def solve(
     stability: bool = True,
     fallback: bool = True,
     guess: Any = None,
+    out: str | None = None,
 ) -> Returned: ...
 def sweep(
     scene: SceneHandle,
@@ -66,6 +67,7 @@ def sweep(
     dofs: str | None = None,
     progress: Callable[[float, str], Any] | None = None,
     guess: Any = None,
+    out: str | None = None,
 ) -> Returned: ...
 def parameter_sweep(
     scene: SceneHandle,
@@ -80,6 +82,7 @@ def parameter_sweep(
     stability: bool = True,
     dofs: str | None = None,
     progress: Callable[[float, str], Any] | None = None,
+    out: str | None = None,
 ) -> Returned: ...
 def modes(
     scene: SceneHandle,
@@ -88,6 +91,7 @@ def modes(
     to: float | None = None,
     max_hz: float | None = None,
     formulation: str | None = None,
+    out: str | None = None,
 ) -> Returned: ...
 def compare(
     scene: SceneHandle,
@@ -97,4 +101,20 @@ def compare(
     samples: int | None = None,
     tolerance: float | None = None,
     formulation: str | None = None,
+    out: str | None = None,
 ) -> Returned: ...
+def report(
+    scene: SceneHandle,
+    out: str,
+    *,
+    to: float | None = None,
+    start: float | None = None,
+    stability: bool = True,
+    output: str | None = None,
+    method: str | None = None,
+    harmonics: int | str | None = None,
+    samples: int | None = None,
+    tolerance: float | None = None,
+    formulation: str | None = None,
+    progress: Callable[[float, str], Any] | None = None,
+) -> tuple[str, int, list[str], list[str], float]: ...

@@ -6,10 +6,13 @@ failure after the input was checked raises :class:`hbal.NumericalError`; a marke
 
 Option names are the command line's, with ``_`` for ``-``; ``--from`` is ``start`` (``from``
 is a Python keyword) and ``--start FILE`` is ``guess=`` (a previous solve's result).
+``out=DIR`` writes the files of ``--out DIR`` (CSV tables and SVG plots): the directory is
+checked before any work; a plot that cannot be drawn is a ``RuntimeWarning``.
 """
 
 from __future__ import annotations
 
+import os
 from typing import Callable, Sequence
 
 import numpy as np
@@ -61,6 +64,16 @@ def _names(name: str, value):
     return ",".join(items)
 
 
+def _out(value):
+    """``out=``: a directory path (str or path-like) or None."""
+    if value is None:
+        return None
+    if isinstance(value, (str, bytes)) or hasattr(value, "__fspath__"):
+        path = os.fspath(value)
+        return path.decode() if isinstance(path, bytes) else path
+    raise _hbal.InputError(f"out: expected a directory path, got {type(value).__name__}")
+
+
 def _scene(scene) -> Scene:
     if isinstance(scene, Scene):
         return scene
@@ -82,6 +95,7 @@ def solve(
     stability: bool = True,
     fallback: bool = True,
     guess: SolveResult | dict | None = None,
+    out: str | os.PathLike | None = None,
 ) -> SolveResult | TorusSolveResult:
     """One periodic solution with its error estimate, Floquet stability and element outputs
     (``hbal solve``). ``harmonics`` is H or ``"auto"``, ``"auto:harmonics"``, ...;
@@ -98,6 +112,7 @@ def solve(
         stability=_flag("stability", stability),
         fallback=_flag("fallback", fallback),
         guess=guess,
+        out=_out(out),
     )
     return (TorusSolveResult if s.on_torus else SolveResult)(record, code, seconds)
 
@@ -122,6 +137,7 @@ def sweep(
     dofs: str | Sequence[str] | None = None,
     progress: Callable[[float, str], None] | None = None,
     guess: SolveResult | dict | None = None,
+    out: str | os.PathLike | None = None,
 ) -> SweepResult | TorusSweepResult:
     """The response over speed from ``start`` (default the scene's speed) to ``to``, in the
     scene's unit, through turning points, with stability (``hbal sweep``).
@@ -148,6 +164,7 @@ def sweep(
         dofs=_names("dofs", dofs),
         progress=_callback("progress", progress),
         guess=guess,
+        out=_out(out),
     )
     return (TorusSweepResult if s.on_torus else SweepResult)(record, code, seconds)
 
@@ -165,6 +182,7 @@ def parameter_sweep(
     stability: bool = True,
     dofs: str | Sequence[str] | None = None,
     progress: Callable[[float, str], None] | None = None,
+    out: str | os.PathLike | None = None,
 ) -> ParameterSweepResult:
     """The response over one numeric scene field (``hbal sweep --parameter``), e.g.
     ``elements[0].k``, at ``points`` evenly spaced values."""
@@ -181,6 +199,7 @@ def parameter_sweep(
         stability=_flag("stability", stability),
         dofs=_names("dofs", dofs),
         progress=_callback("progress", progress),
+        out=_out(out),
     )
     return ParameterSweepResult(record, code, seconds)
 
@@ -192,11 +211,14 @@ def modes(
     to: float | None = None,
     max_hz: float | None = None,
     formulation: str | None = None,
+    out: str | os.PathLike | None = None,
 ) -> ModesResult:
     """Natural frequencies and mode shapes about the periodic solution and the critical
     speeds between ``start`` and ``to`` (``hbal modes``)."""
     s = _scene(scene)
-    record, code, seconds = _hbal.modes(s._handle, start=start, to=to, max_hz=max_hz, formulation=formulation)
+    record, code, seconds = _hbal.modes(
+        s._handle, start=start, to=to, max_hz=max_hz, formulation=formulation, out=_out(out)
+    )
     return ModesResult(record, code, seconds)
 
 
@@ -208,6 +230,7 @@ def compare(
     samples: int | None = None,
     tolerance: float | None = None,
     formulation: str | None = None,
+    out: str | os.PathLike | None = None,
 ) -> CompareResult:
     """Every solver (or ``methods``) and the time-domain reference, with their errors
     (``hbal compare``)."""
@@ -221,5 +244,6 @@ def compare(
         samples=_count("samples", samples),
         tolerance=tolerance,
         formulation=formulation,
+        out=_out(out),
     )
     return CompareResult(record, code, seconds)

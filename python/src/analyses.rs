@@ -11,7 +11,9 @@ use crate::progress::PyProgress;
 use crate::record::{Record, ToRecord};
 use crate::scene::{Prepared, SceneHandle};
 use hbal::analysis as an;
+use hbal::render;
 use pyo3::prelude::*;
+use std::path::{Path, PathBuf};
 
 /// What an analysis returns to Python: its record, its exit code and the wall time of the
 /// library's call alone (s; what the binding adds around it is the rest of the Python call).
@@ -26,25 +28,30 @@ fn timed<T: Send>(py: Python<'_>, analysis: impl FnOnce() -> T + Send) -> (T, f6
     })
 }
 
-/// The record and exit code of an analysis, or its error (a Python law's failure first).
+/// The record and exit code of an analysis, or its error (a Python law's failure first);
+/// its files written into `out` by `write` where given ([`crate::out`]).
 fn finish<'py, T: ToRecord + 'static>(
     py: Python<'py>,
     prepared: &Prepared<'_>,
     (result, seconds): (hbal::Result<T>, f64),
     exit_code: impl FnOnce(&T) -> u8,
+    out: Option<&Path>,
+    write: impl FnOnce(&T, &Path, &mut Vec<String>) -> hbal::Result<()> + Send,
 ) -> PyResult<Returned<'py>> {
     if let Some(e) = prepared.slot.take() {
         return Err(e);
     }
     let analysis = result.map_err(|e| prepared.error(py, e))?;
     let code = exit_code(&analysis);
+    let a = &analysis;
+    crate::out::write(py, prepared, out, |dir, w| write(a, dir, w))?;
     Ok((Bound::new(py, Record::new(analysis))?, code, seconds))
 }
 
 /// One periodic solution (`hbal solve`): on several base frequencies where the scene is.
 #[pyfunction]
 #[pyo3(signature = (scene, *, method=None, harmonics=None, samples=None, tolerance=None,
-    formulation=None, stability=true, fallback=true, guess=None))]
+    formulation=None, stability=true, fallback=true, guess=None, out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn solve<'py>(
     py: Python<'py>,
@@ -57,16 +64,21 @@ pub fn solve<'py>(
     stability: bool,
     fallback: bool,
     guess: Option<&Bound<'py, PyAny>>,
+    out: Option<PathBuf>,
 ) -> PyResult<Returned<'py>> {
     let o = overrides(method, harmonics, samples, tolerance, formulation)?;
     let p = scene.get().prepare(py, &o)?;
     let s: &hbal::scene::Scene = &p.scene;
+    let out = out.as_deref();
     if s.torus.is_some() {
         refuse_on_torus(&[("fallback", !fallback), ("guess", guess.is_some())])?;
+        crate::out::prepare(py, &p, out, &render::torus_solve_files())?;
         let settings = an::TorusSolveSettings { speed: None };
         let result = timed(py, || an::torus_solve(s, &settings));
-        return finish(py, &p, result, |a| a.exit_code());
+        let write = |a: &_, dir: &Path, w: &mut _| render::write_torus_solve_files(dir, s, a, w);
+        return finish(py, &p, result, |a| a.exit_code(), out, write);
     }
+    crate::out::prepare(py, &p, out, &render::solve_files())?;
     let settings = an::SolveSettings {
         start: start_of(guess, s)?.map(|g| (g.harmonics, "guess".to_string())),
         stability,
@@ -74,7 +86,8 @@ pub fn solve<'py>(
         formulation: o.formulation,
     };
     let result = timed(py, || an::solve(s, &settings));
-    finish(py, &p, result, |a| a.exit_code())
+    let write = |a: &_, dir: &Path, w: &mut _| render::write_solve_files(s, a, dir, w).map(|_| ());
+    finish(py, &p, result, |a| a.exit_code(), out, write)
 }
 
 /// A speed sweep (`hbal sweep --to`): through turning points with stability, or at evenly
@@ -83,7 +96,7 @@ pub fn solve<'py>(
 #[pyo3(signature = (scene, to, *, start=None, harmonics=None, samples=None, tolerance=None,
     formulation=None, stability=true, stability_orbit="exact", max_points=None, max_step=0.5,
     points=101, all_branches=false, error_estimate=true, output=None, dofs=None, progress=None,
-    guess=None))]
+    guess=None, out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -105,7 +118,9 @@ pub fn sweep<'py>(
     dofs: Option<String>,
     progress: Option<Py<PyAny>>,
     guess: Option<&Bound<'py, PyAny>>,
+    out: Option<PathBuf>,
 ) -> PyResult<Returned<'py>> {
+    let out = out.as_deref();
     // As the command line: the tolerance is checked with the scene's, and is the corrector's.
     let o = overrides(None, harmonics, samples, tolerance, formulation)?;
     let points = points_in_range("points", points, 2)?;
@@ -126,6 +141,8 @@ pub fn sweep<'py>(
             ("stability_orbit", orbit != hbal::stability::Orbit::Exact),
             ("output", output.is_some()),
         ])?;
+        let shown = render::torus_shown(s, None).map_err(|e| p.error(py, e))?;
+        crate::out::prepare(py, &p, out, &render::torus_sweep_files())?;
         let settings = an::TorusSweepSettings {
             from: start,
             to,
@@ -133,7 +150,10 @@ pub fn sweep<'py>(
         };
         let result = timed(py, || an::torus_sweep(s, &settings, &mut observer));
         observer.raise()?;
-        return finish(py, &p, result, |a| a.exit_code());
+        let write = |a: &_, dir: &Path, w: &mut _| {
+            render::write_torus_sweep_files(dir, s, a, shown.as_deref(), w)
+        };
+        return finish(py, &p, result, |a| a.exit_code(), out, write);
     }
     let guess = start_of(guess, s)?.map(|g| an::SweepStart {
         harmonics: g.harmonics,
@@ -158,19 +178,23 @@ pub fn sweep<'py>(
         ..an::SweepSettings::to(to)
     };
     an::check_sweep(s, &settings).map_err(|e| p.error(py, e))?;
+    if let Some(dir) = out {
+        render::prepare_sweep_out(dir, s, settings.dofs.as_deref()).map_err(|e| p.error(py, e))?;
+    }
     let result = timed(py, || an::sweep(s, &settings, &mut observer));
     // A law's failure first: it cancelled the sweep.
     if let Some(e) = p.slot.take() {
         return Err(e);
     }
     observer.raise()?;
-    finish(py, &p, result, |a| a.exit_code())
+    let write = |a: &_, dir: &Path, w: &mut _| render::write_sweep_files(dir, s, a, w);
+    finish(py, &p, result, |a| a.exit_code(), out, write)
 }
 
 /// A sweep of one numeric scene field (`hbal sweep --parameter`).
 #[pyfunction]
 #[pyo3(signature = (scene, parameter, start, to, *, points=101, harmonics=None, samples=None,
-    formulation=None, stability=true, dofs=None, progress=None))]
+    formulation=None, stability=true, dofs=None, progress=None, out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn parameter_sweep<'py>(
     py: Python<'py>,
@@ -185,7 +209,9 @@ pub fn parameter_sweep<'py>(
     stability: bool,
     dofs: Option<String>,
     progress: Option<Py<PyAny>>,
+    out: Option<PathBuf>,
 ) -> PyResult<Returned<'py>> {
+    let out = out.as_deref();
     let handle = scene.get();
     let mut observer = PyProgress::new(progress);
     let settings = an::ParameterSweepSettings {
@@ -203,6 +229,10 @@ pub fn parameter_sweep<'py>(
     p.slot.stops(&observer.cancel);
     let (doc, file) = (&handle.document, handle.file.as_str());
     an::check_parameter_sweep(doc, file, &settings).map_err(|e| p.error(py, e))?;
+    // The DOF names of the scene make the file names.
+    let files =
+        render::parameter_sweep_files(p.scene.model.dof_names()).map_err(|e| p.error(py, e))?;
+    crate::out::prepare(py, &p, out, &files)?;
     let result = timed(py, || {
         an::parameter_sweep(doc, file, &settings, &mut observer)
     });
@@ -210,13 +240,14 @@ pub fn parameter_sweep<'py>(
         return Err(e);
     }
     observer.raise()?;
-    finish(py, &p, result, |a| a.exit_code())
+    let write = |a: &_, dir: &Path, w: &mut _| render::write_parameter_sweep_files(dir, a, w);
+    finish(py, &p, result, |a| a.exit_code(), out, write)
 }
 
 /// Natural frequencies and mode shapes about the periodic solution, critical speeds
 /// (`hbal modes`).
 #[pyfunction]
-#[pyo3(signature = (scene, *, start=None, to=None, max_hz=None, formulation=None))]
+#[pyo3(signature = (scene, *, start=None, to=None, max_hz=None, formulation=None, out=None))]
 pub fn modes<'py>(
     py: Python<'py>,
     scene: &Bound<'py, SceneHandle>,
@@ -224,7 +255,9 @@ pub fn modes<'py>(
     to: Option<f64>,
     max_hz: Option<f64>,
     formulation: Option<&str>,
+    out: Option<PathBuf>,
 ) -> PyResult<Returned<'py>> {
+    let out = out.as_deref();
     let settings = an::ModesSettings {
         from: start,
         to,
@@ -235,14 +268,16 @@ pub fn modes<'py>(
         .get()
         .prepare(py, &crate::scene::command_line_defaults())?;
     let s: &hbal::scene::Scene = &p.scene;
+    crate::out::prepare(py, &p, out, &render::modes_files())?;
     let result = timed(py, || an::modes(s, &settings));
-    finish(py, &p, result, |_| 0)
+    let write = |a: &_, dir: &Path, w: &mut _| render::write_modes_files(dir, s, a, w);
+    finish(py, &p, result, |_| 0, out, write)
 }
 
 /// Every solver (or those of `methods`) and the time-domain reference (`hbal compare`).
 #[pyfunction]
 #[pyo3(signature = (scene, *, methods=None, harmonics=None, samples=None, tolerance=None,
-    formulation=None))]
+    formulation=None, out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn compare<'py>(
     py: Python<'py>,
@@ -252,7 +287,9 @@ pub fn compare<'py>(
     samples: Option<usize>,
     tolerance: Option<f64>,
     formulation: Option<&str>,
+    out: Option<PathBuf>,
 ) -> PyResult<Returned<'py>> {
+    let out = out.as_deref();
     let o = overrides(None, harmonics, samples, None, formulation)?;
     if let Some(t) = tolerance {
         hbal::scene::check_tolerance(t).map_err(|e| crate::options::invalid("tolerance", e))?;
@@ -264,8 +301,10 @@ pub fn compare<'py>(
         tolerance,
         formulation: o.formulation,
     };
+    crate::out::prepare(py, &p, out, &render::compare_files())?;
     let result = timed(py, || an::compare(s, &settings));
-    finish(py, &p, result, |a| a.exit_code())
+    let write = |a: &_, dir: &Path, w: &mut _| render::write_compare_files(dir, a, w);
+    finish(py, &p, result, |a| a.exit_code(), out, write)
 }
 
 /// Checks the scene as a solve would before its first iteration (`hbal check`).

@@ -10,8 +10,10 @@ mod document;
 mod errors;
 mod law;
 mod options;
+mod out;
 mod progress;
 mod record;
+mod report;
 mod scene;
 mod thread_state;
 mod value;
@@ -34,6 +36,7 @@ fn _hbal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::modes, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::compare, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::check, m)?)?;
+    m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add("SCHEMA_VERSION", hbal::analysis::SCHEMA_VERSION)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

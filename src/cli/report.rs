@@ -35,6 +35,7 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
         output: opts.output.map(str::to_string),
         formulation: args.formulation,
         tolerance: args.tolerance,
+        ..ReportSettings::default()
     };
     let r = hbal::render::report(&scene, &scene_text, &settings, opts.out, &mut Stages)
         .map_err(|e| super::failure(e, &scene.file))?;

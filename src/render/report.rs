@@ -32,6 +32,8 @@ pub struct ReportSettings {
     pub formulation: Formulation,
     /// The run-up's solver tolerance (default: the scene's).
     pub tolerance: Option<f64>,
+    /// Stops the run-up at its next point (its branch so far is reported).
+    pub cancel: crate::continuation::Cancel,
 }
 
 /// One part of the report: its result, or why there is none, and its exit code.
@@ -269,6 +271,7 @@ fn sweep_part(
         formulation: settings.formulation,
         tolerance: settings.tolerance,
         output: settings.output.clone(),
+        cancel: settings.cancel.clone(),
         ..SweepSettings::to(to)
     };
     let dir = out.join("sweep");
