@@ -66,6 +66,7 @@ mod piecewise_exact_cli;
 mod planetary;
 mod published_lines;
 mod reference_solutions;
+mod render_library;
 mod report;
 mod s_curve;
 mod scene_export;

@@ -1,0 +1,95 @@
+//! `hbal::render` from the library: the report's typed parts hold the analyses the page shows
+//! (the solve's numbers are those of `analysis::solve`), the files land where the command
+//! line puts them, and bad input is an error with exit code 2 before anything is written.
+
+use hbal::analysis::{solve, Silent, SolveSettings};
+use hbal::render::{report, ReportParts, ReportSettings};
+use hbal::scene::Scene;
+use std::path::Path;
+
+fn load(name: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/scenes")
+        .join(name);
+    Scene::load(&path).expect("example scene")
+}
+
+#[test]
+fn the_report_returns_the_analyses_its_page_shows() {
+    let scene = load("gear_backlash.toml");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_library_report");
+    let _ = std::fs::remove_dir_all(&dir);
+    let settings = ReportSettings {
+        to: Some(0.9),
+        stability: true,
+        ..ReportSettings::default()
+    };
+    let r = report(&scene, "", &settings, &dir, &mut Silent).expect("report");
+    assert_eq!((r.exit_code, r.errors().len()), (0, 0), "{:?}", r.errors());
+    assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    let ReportParts::Periodic(parts) = &r.parts else {
+        panic!("a periodic scene");
+    };
+    let solved = parts.solved.result.as_ref().expect("the solve");
+    // The same solve as the analysis on its own: the gear's harmonics to the bit.
+    let alone = solve(
+        &scene,
+        &SolveSettings {
+            stability: true,
+            ..SolveSettings::default()
+        },
+    )
+    .expect("solve");
+    assert_eq!(solved.solution.harmonics(), alone.solution.harmonics());
+    let swept = parts
+        .swept
+        .as_ref()
+        .and_then(|p| p.result.as_ref())
+        .expect("run-up");
+    assert!(swept.branch.points.len() > 5);
+    let moded = parts.moded.result.as_ref().expect("modes");
+    assert!(moded.natural.is_some());
+    let page = std::fs::read_to_string(&r.file).expect("report.html");
+    // The page shows the solve's peak-to-peak of x with 4 significant digits.
+    let x = solved.solution.time_series(0, 512);
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    assert!(hi > lo);
+    for f in [
+        "solve/harmonics.csv",
+        "sweep/branch.csv",
+        "modes/campbell.svg",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    assert!(page.contains("<svg"), "inlined plots");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_report_input_is_an_input_error_before_anything_is_written() {
+    let scene = load("gear_backlash.toml");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_library_bad");
+    let _ = std::fs::remove_dir_all(&dir);
+    let cases = [
+        (Some(0.5), None, None, "--from needs --to"),
+        (None, Some(-1.0), None, "--to"),
+        (None, None, Some("x"), "--output chooses the run-up's plots"),
+        (None, Some(0.9), Some("nothing"), "nothing"),
+    ];
+    for (from, to, output, says) in cases {
+        let settings = ReportSettings {
+            from,
+            to,
+            output: output.map(String::from),
+            ..ReportSettings::default()
+        };
+        let e = report(&scene, "", &settings, &dir, &mut Silent).expect_err(says);
+        assert_eq!(e.exit_code(), 2, "{e}");
+        assert!(e.to_string().contains(says), "{e}");
+        assert!(!dir.join("report.html").exists());
+    }
+}
