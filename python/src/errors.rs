@@ -36,10 +36,55 @@ pub fn to_py(py: Python<'_>, e: hbal::Error) -> PyErr {
     }
     let message = e.to_string();
     if e.exit_code() == 2 {
-        InputError::new_err(message)
+        InputError::new_err(python_names(&message))
     } else {
         NumericalError::new_err(message)
     }
+}
+
+/// The library's message with the command line's flags named as this package's arguments:
+/// `--from` is `` `start` ``, `--start` `` `guess` ``, `--no-stability` `` `stability=False` ``,
+/// any other `--some-flag` `` `some_flag` ``.
+///
+/// "--from needs --to" becomes "`start` needs `to`".
+pub fn python_names(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(at) = rest.find("--") {
+        let before = &rest[..at];
+        let after = &rest[at + 2..];
+        let len = after
+            .find(|c: char| !(c.is_ascii_lowercase() || c == '-'))
+            .unwrap_or(after.len());
+        let flag = &after[..len];
+        let starts_word = before
+            .chars()
+            .next_back()
+            .is_none_or(|c| c == ' ' || c == '(' || c == '`');
+        out.push_str(before);
+        if flag.is_empty() || !starts_word || !flag.starts_with(|c: char| c.is_ascii_lowercase()) {
+            out.push_str("--");
+            rest = after;
+            continue;
+        }
+        let name = match flag {
+            "from" => "start".to_string(),
+            "start" => "guess".to_string(),
+            "no-stability" => "stability=False".to_string(),
+            f => f.replace('-', "_"),
+        };
+        let quoted = before.ends_with('`');
+        if quoted {
+            out.push_str(&name);
+        } else {
+            out.push('`');
+            out.push_str(&name);
+            out.push('`');
+        }
+        rest = &after[len..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// A [`SceneError`] with its attributes.
@@ -63,4 +108,28 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LawError", py.get_type::<LawError>())?;
     m.add("NumericalError", py.get_type::<NumericalError>())?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::python_names;
+
+    #[test]
+    fn flags_become_argument_names() {
+        assert_eq!(
+            python_names("--from needs --to (the run-up's end speed)"),
+            "`start` needs `to` (the run-up's end speed)"
+        );
+        assert_eq!(
+            python_names("--out /tmp/x: cannot create the directory"),
+            "`out` /tmp/x: cannot create the directory"
+        );
+        assert_eq!(python_names("`--start` x"), "`guess` x");
+        assert_eq!(
+            python_names("--max-points must be >= 1"),
+            "`max_points` must be >= 1"
+        );
+        // Not a flag: inside a word, a bare `--`, a number.
+        assert_eq!(python_names("a--b -- --5"), "a--b -- --5");
+    }
 }

@@ -89,8 +89,8 @@ def test_report_of_a_torus_scene(tmp_path):
 def test_bad_report_input_is_refused_before_anything_is_written(tmp_path):
     scene = hbal.Scene.load(scene_path("gear_backlash.toml"))
     for kwargs, says in [
-        (dict(to=-1.0), "--to"),
-        (dict(start=0.5), "--from needs --to"),
+        (dict(to=-1.0), "`to` must be"),
+        (dict(start=0.5), "`start` needs `to`"),
         (dict(to=0.9, output="nothing"), "nothing"),
     ]:
         out = tmp_path / "r"

@@ -75,7 +75,7 @@ def test_bad_options_are_input_errors_before_any_work():
         hbal.solve(scene, formulation="dense")
     with pytest.raises(hbal.InputError, match="points"):
         hbal.sweep(scene, 2.0, points=1)
-    with pytest.raises(hbal.InputError, match="--to must be a finite speed"):
+    with pytest.raises(hbal.InputError, match="`to` must be a finite speed"):
         hbal.sweep(scene, float("nan"))
     with pytest.raises(hbal.InputError, match="stability_orbit"):
         hbal.sweep(scene, 2.0, stability_orbit="hill")
