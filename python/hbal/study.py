@@ -252,7 +252,11 @@ class _Store:
 
 def run_chunk(payload, items):
     """A task: the table of the variants ``items`` (pairs of index and fields), built where
-    it runs (a DataFrame ships back in a few buffers, light for the client)."""
+    it runs (a DataFrame ships back in a few buffers, light for the client). A study runs one
+    task per core, so each analysis keeps to its own (``HBAL_THREADS=1``: no second thread for
+    the stability's products) unless the environment says otherwise; the results are the
+    same to the bit either way."""
+    os.environ.setdefault("HBAL_THREADS", "1")
     text, file, laws, spec = payload
     base = Scene(json.loads(text), file=file, laws=laws)
     rows = []

@@ -114,13 +114,13 @@ impl Continuation {
 
     /// Whether `branch` of `model` is followed with a worker: stability on, its last point's
     /// stability took at least
-    /// [`Continuation::stability_worker`], and a second core.
+    /// [`Continuation::stability_worker`], and a second core (`HBAL_THREADS` not 1).
     pub(super) fn pipelined(&self, _model: &Model, branch: &Branch) -> bool {
         let took = branch.stability_cache.last_time();
         self.stability.is_some()
             && self
                 .stability_worker
                 .is_some_and(|from| took.is_some_and(|t| t >= from))
-            && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+            && crate::linear::parallel::second_thread()
     }
 }

@@ -37,6 +37,20 @@ pub(crate) fn threads_for_long_tasks() -> usize {
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
+/// Whether an analysis may keep a second thread busy beside its own (the stability's
+/// assembler, a sweep's stability worker): `HBAL_THREADS` of 2 or more, or, where it is not
+/// set, at least two available cores. A study running one analysis per core sets
+/// `HBAL_THREADS=1`: each analysis then keeps to its core.
+pub(crate) fn second_thread() -> bool {
+    match std::env::var("HBAL_THREADS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+    {
+        Some(t) => t >= 2,
+        None => std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2),
+    }
+}
+
 /// `[f(0, items[0]), f(1, items[1]), …]` on up to `threads` threads: each call owns its item
 /// (a buffer of the last speed's, to be filled again instead of allocated).
 pub(crate) fn map_owned<B: Send, T: Send>(

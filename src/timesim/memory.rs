@@ -223,6 +223,11 @@ impl Solout<f64, Vec<f64>> for Commit<'_, '_> {
     }
 }
 
+/// Most restarts of the integrator within one segment: a law's state that holds and lets go
+/// again and again (chattering) would restart it without end. A smooth orbit restarts a few
+/// times per switch of a law.
+const MAX_RESTARTS: usize = 10_000;
+
 /// Integrates the segment `[w0, w1]` (angles) of period `p` (start time `t_period`) from `y`,
 /// committing the states of the laws with memory; samples `q` at the angles `2π j / N` inside
 /// the segment if `samples` is given. Returns the end time and state.
@@ -252,7 +257,14 @@ pub(super) fn integrate_segment(
     let mut error = None;
     let (mut t, mut y, mut next) = (ta, y, 0);
     // A fresh integrator from every restart (its first step chosen for what is left).
-    loop {
+    for restarts in 0.. {
+        if restarts > MAX_RESTARTS {
+            return Err(Error::TimeIntegration {
+                reason: format!(
+                    "a law with memory switched between holding and moving {MAX_RESTARTS} times within one segment at t = {t:.6e} s (it chatters: a contact or slider on an almost free or very stiff DOF); check the stiffness, masses and loads for a unit mistake, or skip the stability (--no-stability)"
+                ),
+            });
+        }
         let mut restart = None;
         let commit = Commit {
             rhs,

@@ -150,3 +150,35 @@ fn a_reference_quantity_without_range_has_a_finite_error() {
     assert!((0.5..=1.0).contains(&error), "{worst}");
     let _ = std::fs::remove_dir_all(temp_dir());
 }
+
+/// Found by the hostile property test: the clutch damper with its spring to ground only, the
+/// spline twice as stiff and the gearbox almost free. The friction washers chatter between
+/// stick and slip in the stability's shooting, which restarted its integrator without end (a
+/// solve ran for hours); now the chattering is a named stability failure within a second, the
+/// solve itself stands, exit code 1.
+#[test]
+fn a_chattering_slider_stops_the_shooting_with_its_reason() {
+    let scene = edited(
+        "clutch_damper_hysteresis.toml",
+        "[0.0, 20000.0, -20000.0], [0.0, -20000.0, 20800.0]",
+        "[0.0, 40000.0, -20000.0], [0.0, -20000.0, 0.0208]",
+    )
+    .replace(
+        "connects = { flywheel = 1.0, hub = -1.0 }   # u = damper twist, rad",
+        "connects = { hub = -1.0 }",
+    );
+    let file = write(&temp_dir(), "chatter.toml", &scene);
+    let run = run_limited(&["solve", "--json", &file]);
+    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    assert!(run.seconds < 30.0, "{} s", run.seconds);
+    assert!(
+        run.stderr
+            .contains("switched between holding and moving 10000 times"),
+        "{}",
+        run.stderr
+    );
+    judge_document(&run, Document::Solve).unwrap_or_else(|(b, w)| panic!("{b:?}: {w}"));
+    let doc: serde_json::Value = serde_json::from_str(&run.stdout).expect("one JSON object");
+    assert_eq!(doc["converged"], true, "the solve itself stands");
+    let _ = std::fs::remove_dir_all(temp_dir());
+}

@@ -9,8 +9,8 @@
 //! whose `Φ̃` is not asked for (a chord step follows it) is abandoned when the next pass
 //! begins.
 //!
-//! Used where the machine has at least two cores
-//! ([`std::thread::available_parallelism`]); otherwise the record is replayed after the pass.
+//! Used where the machine has at least two cores and `HBAL_THREADS` does not say 1
+//! (`linear::parallel::second_thread`); otherwise the record is replayed after the pass.
 
 use super::generator::Core;
 use super::integration::Integration;
@@ -143,7 +143,7 @@ fn parallel() -> bool {
     if let Some(forced) = tests::FORCE.with(|f| f.get()) {
         return forced;
     }
-    std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+    crate::linear::parallel::second_thread()
 }
 
 impl<'c, 'm> Integration<'c, 'm> {
