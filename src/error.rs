@@ -177,6 +177,13 @@ pub enum Error {
     /// checked).
     #[error("{0}")]
     Output(String),
+    /// An analysis stopped by its caller (Ctrl-C in Python, a progress callback that raised)
+    /// before it finished: nothing of it is reported.
+    #[error("{what} cancelled")]
+    Cancelled {
+        /// The analysis, e.g. `the report`.
+        what: String,
+    },
 }
 
 impl Error {
@@ -193,7 +200,10 @@ impl Error {
     /// ```
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::NonFinite { .. } | Error::Solver { .. } | Error::TimeIntegration { .. } => 1,
+            Error::NonFinite { .. }
+            | Error::Solver { .. }
+            | Error::TimeIntegration { .. }
+            | Error::Cancelled { .. } => 1,
             Error::AfterCheck(inner) if matches!(**inner, Error::TooLarge { .. }) => 2,
             Error::AfterCheck(_) => 1,
             _ => 2,

@@ -74,6 +74,7 @@ pub mod torus;
 
 pub use error::{Error, Result};
 pub use harmonic::HarmonicBasis;
+pub use linear::parallel::limit_threads_here;
 pub use linear::Formulation;
 pub use model::{Element, Model};
 /// The linear-algebra crate of hbal's API (matrices of [`Model`]).

@@ -68,10 +68,17 @@ def _out(value):
     """``out=``: a directory path (str or path-like) or None."""
     if value is None:
         return None
-    if isinstance(value, (str, bytes)) or hasattr(value, "__fspath__"):
-        path = os.fspath(value)
-        return path.decode() if isinstance(path, bytes) else path
-    raise _hbal.InputError(f"out: expected a directory path, got {type(value).__name__}")
+    if not (isinstance(value, (str, bytes)) or hasattr(value, "__fspath__")):
+        raise _hbal.InputError(f"out: expected a directory path, got {type(value).__name__}")
+    try:
+        path = os.fsdecode(value)
+    except (UnicodeDecodeError, TypeError) as e:
+        raise _hbal.InputError(f"out: not a usable path: {e}") from None
+    if not path:
+        raise _hbal.InputError("out: an empty path (give a directory, e.g. '.')")
+    if "\0" in path:
+        raise _hbal.InputError("out: the path contains a NUL character")
+    return path
 
 
 def _scene(scene) -> Scene:

@@ -253,16 +253,20 @@ class _Store:
 def run_chunk(payload, items):
     """A task: the table of the variants ``items`` (pairs of index and fields), built where
     it runs (a DataFrame ships back in a few buffers, light for the client). A study runs one
-    task per core, so each analysis keeps to its own (``HBAL_THREADS=1``: no second thread for
-    the stability's products) unless the environment says otherwise; the results are the
-    same to the bit either way."""
-    os.environ.setdefault("HBAL_THREADS", "1")
-    text, file, laws, spec = payload
-    base = Scene(json.loads(text), file=file, laws=laws)
-    rows = []
-    for index, fields in items:
-        rows.extend(_variant_rows(base, index, fields, spec))
-    return _frame(rows, spec["paths"])
+    task per core, so each analysis keeps to its own (no second thread for the stability's
+    products; on this thread only) unless ``HBAL_THREADS`` says otherwise; the results are
+    the same to the bit either way."""
+    limit = None if "HBAL_THREADS" in os.environ else 1
+    before = _hbal.limit_threads_here(limit)
+    try:
+        text, file, laws, spec = payload
+        base = Scene(json.loads(text), file=file, laws=laws)
+        rows = []
+        for index, fields in items:
+            rows.extend(_variant_rows(base, index, fields, spec))
+        return _frame(rows, spec["paths"])
+    finally:
+        _hbal.limit_threads_here(before)
 
 
 def _head(index, fields, spec) -> tuple:

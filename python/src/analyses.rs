@@ -270,8 +270,8 @@ pub fn modes<'py>(
     let s: &hbal::scene::Scene = &p.scene;
     crate::out::prepare(py, &p, out, &render::modes_files())?;
     let result = timed(py, || an::modes(s, &settings));
-    let write = |a: &_, dir: &Path, w: &mut _| render::write_modes_files(dir, s, a, w);
-    finish(py, &p, result, |_| 0, out, write)
+    let write = |a: &_, dir: &Path, w: &mut _| render::write_modes_files(dir, s, a, w).map(|_| ());
+    finish(py, &p, result, an::ModesAnalysis::exit_code, out, write)
 }
 
 /// Every solver (or those of `methods`) and the time-domain reference (`hbal compare`).
@@ -316,4 +316,12 @@ pub fn check(py: Python<'_>, scene: &Bound<'_, SceneHandle>) -> PyResult<()> {
     let s: &hbal::scene::Scene = &p.scene;
     py.detach(|| an::check(s)).map_err(|e| p.error(py, e))?;
     p.slot.take().map_or(Ok(()), Err)
+}
+
+/// Limits the threads of the analyses started on the calling thread (`hbal::limit_threads_here`):
+/// a study's task sets 1, so that every analysis keeps to its core; returns the limit before.
+#[pyfunction]
+#[pyo3(signature = (limit=None))]
+pub fn limit_threads_here(limit: Option<usize>) -> Option<usize> {
+    hbal::limit_threads_here(limit)
 }

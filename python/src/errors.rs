@@ -42,44 +42,62 @@ pub fn to_py(py: Python<'_>, e: hbal::Error) -> PyErr {
     }
 }
 
-/// The library's message with the command line's flags named as this package's arguments:
-/// `--from` is `` `start` ``, `--start` `` `guess` ``, `--no-stability` `` `stability=False` ``,
-/// any other `--some-flag` `` `some_flag` ``.
-///
-/// "--from needs --to" becomes "`start` needs `to`".
+/// The command line's flags of the options this package takes, and their argument names.
+const FLAGS: &[(&str, &str)] = &[
+    ("from", "start"),
+    ("start", "guess"),
+    ("no-stability", "stability=False"),
+    ("no-fallback", "fallback=False"),
+    ("to", "to"),
+    ("out", "out"),
+    ("output", "output"),
+    ("points", "points"),
+    ("max-points", "max_points"),
+    ("max-step", "max_step"),
+    ("tolerance", "tolerance"),
+    ("harmonics", "harmonics"),
+    ("samples", "samples"),
+    ("method", "method"),
+    ("formulation", "formulation"),
+    ("dofs", "dofs"),
+    ("parameter", "parameter"),
+    ("stability-orbit", "stability_orbit"),
+    ("max-hz", "max_hz"),
+];
+
+/// The library's message with the command line's flags (those of [`FLAGS`], as words of
+/// their own) named as this package's arguments: "--from needs --to" becomes "`start` needs
+/// `to`". Anything else with `--` (a name, a path) is left as it is.
 pub fn python_names(message: &str) -> String {
     let mut out = String::with_capacity(message.len());
     let mut rest = message;
     while let Some(at) = rest.find("--") {
-        let before = &rest[..at];
-        let after = &rest[at + 2..];
+        let (before, after) = (&rest[..at], &rest[at + 2..]);
         let len = after
             .find(|c: char| !(c.is_ascii_lowercase() || c == '-'))
             .unwrap_or(after.len());
-        let flag = &after[..len];
+        let ends_word = after[len..]
+            .chars()
+            .next()
+            .is_none_or(|c| !(c.is_alphanumeric() || c == '_' || c == '/' || c == '.'));
         let starts_word = before
             .chars()
             .next_back()
             .is_none_or(|c| c == ' ' || c == '(' || c == '`');
+        let name = FLAGS.iter().find(|f| f.0 == &after[..len]).map(|f| f.1);
         out.push_str(before);
-        if flag.is_empty() || !starts_word || !flag.starts_with(|c: char| c.is_ascii_lowercase()) {
-            out.push_str("--");
-            rest = after;
-            continue;
-        }
-        let name = match flag {
-            "from" => "start".to_string(),
-            "start" => "guess".to_string(),
-            "no-stability" => "stability=False".to_string(),
-            f => f.replace('-', "_"),
-        };
-        let quoted = before.ends_with('`');
-        if quoted {
-            out.push_str(&name);
-        } else {
-            out.push('`');
-            out.push_str(&name);
-            out.push('`');
+        match name.filter(|_| starts_word && ends_word) {
+            Some(name) if before.ends_with('`') => out.push_str(name),
+            Some(name) => {
+                out.push('`');
+                out.push_str(name);
+                out.push('`');
+            }
+            None => {
+                out.push_str("--");
+                rest = after;
+                continue;
+            }
         }
         rest = &after[len..];
     }
@@ -129,7 +147,11 @@ mod tests {
             python_names("--max-points must be >= 1"),
             "`max_points` must be >= 1"
         );
-        // Not a flag: inside a word, a bare `--`, a number.
+        // Not a flag: inside a word, a bare `--`, a number, a name or path that is no flag.
         assert_eq!(python_names("a--b -- --5"), "a--b -- --5");
+        assert_eq!(
+            python_names("(its 1 DOFs: `--gear-shaft`) /x --y --to/z"),
+            "(its 1 DOFs: `--gear-shaft`) /x --y --to/z"
+        );
     }
 }

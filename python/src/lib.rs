@@ -37,6 +37,7 @@ fn _hbal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::compare, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::check, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::limit_threads_here, m)?)?;
     m.add("SCHEMA_VERSION", hbal::analysis::SCHEMA_VERSION)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -63,7 +63,11 @@ pub fn report<'py>(
     observer.raise()?;
     let r = result.map_err(|e| p.error(py, e))?;
     crate::out::warn(py, &r.warnings)?;
-    let mut errors: Vec<String> = r.errors().iter().map(|e| e.to_string()).collect();
+    let mut errors: Vec<String> = r
+        .errors()
+        .iter()
+        .map(|e| crate::errors::python_names(e))
+        .collect();
     if let ReportParts::Periodic(parts) = &r.parts {
         if let Some(a) = &parts.solved.result {
             errors.splice(0..0, solve_failures(&s.file, a));

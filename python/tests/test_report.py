@@ -5,6 +5,7 @@ same sections; bad input refused before anything is written."""
 from __future__ import annotations
 
 import filecmp
+import os
 import subprocess
 from pathlib import Path
 
@@ -119,3 +120,40 @@ def test_a_failed_part_is_in_the_page_and_the_errors(tmp_path):
     assert r.exit_code == 1
     assert any("did not converge" in e for e in r.errors), r.errors
     assert "did not converge" in r.path.read_text() or "NOT CONVERGED" in r.path.read_text()
+
+
+def test_a_torus_report_refuses_bad_speeds_before_any_work(tmp_path):
+    scene = hbal.Scene.load(scene_path("two_stage_train_torus.toml"))
+    for kwargs, says in [(dict(to=-1.0), "`to` must be a finite speed"), (dict(to=3000.0, start=0.0), "`start` must be")]:
+        with pytest.raises(hbal.InputError, match=says):
+            hbal.report(scene, tmp_path / "t", **kwargs)
+        assert not (tmp_path / "t").exists()
+
+
+def test_a_cancelled_report_writes_no_page(tmp_path):
+    def fail(fraction, stage):
+        if stage.startswith("sweep") or fraction > 0:
+            raise ZeroDivisionError("stop here")
+
+    with pytest.raises(ZeroDivisionError, match="stop here"):
+        hbal.report(scene_path("gear_backlash.toml"), tmp_path, to=2.0, progress=fail)
+    assert not (tmp_path / "report.html").exists()
+    assert not (tmp_path / "modes" / "modes.csv").exists()
+
+
+def test_modes_of_an_unconverged_operating_point_are_marked(tmp_path):
+    doc = hbal.Scene.load(scene_path("gear_backlash.toml")).to_dict()
+    doc["loads"][0]["cos"] = 0.0
+    doc["solver"] = {"method": "newton"}
+    r = hbal.modes(hbal.Scene.from_dict(doc), out=tmp_path)
+    assert r.exit_code == 1 and not r.ok
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_out_paths_that_cannot_be_used(tmp_path):
+    scene = hbal.Scene.load(scene_path("duffing.toml"))
+    for bad, says in [("", "empty path"), ("a\0b", "NUL")]:
+        with pytest.raises(hbal.InputError, match=says):
+            hbal.solve(scene, out=bad)
+    r = hbal.solve(scene, out=os.fsencode(str(tmp_path / "bytes")))
+    assert (tmp_path / "bytes" / "harmonics.csv").exists() and r.exit_code == 0

@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 from hbal import study, variants as v
 
-from conftest import scene_path
+from conftest import assert_bitwise_equal, scene_path, without_times
 
 SPEEDS = [5000.0, 7000.0]
 QUANTITIES = ["gear", "u(mesh)"]
@@ -146,3 +146,24 @@ def test_a_study_of_sweeps_gives_the_transmission_error_from_the_dofs():
     assert abs(row.amplitude - expected) <= 1e-6 * expected
     with pytest.raises(hbal.InputError, match="f\\(mesh\\)"):
         study.run(scene, [{}], sweep_to=3000.0, quantities=["f(mesh)"])
+
+
+def test_a_threaded_study_keeps_each_task_on_one_thread_and_leaves_the_caller_alone(two_shaft):
+    import concurrent.futures as cf
+
+    from hbal import _hbal
+
+    variants = mesh_variants(two_shaft, 6)
+    with cf.ThreadPoolExecutor(2) as pool:
+        threaded = run(two_shaft, variants, executor=pool)
+    # The limit is the task's thread's own, undone after it; the environment is untouched.
+    assert _hbal.limit_threads_here(None) is None
+    assert "HBAL_THREADS" not in os.environ
+    # One thread or two for the stability's products: the same numbers to the bit.
+    scene = two_shaft.with_parameters(variants[2])
+    before = _hbal.limit_threads_here(1)
+    one = hbal.solve(scene)
+    _hbal.limit_threads_here(before)
+    two = hbal.solve(scene)
+    assert_bitwise_equal(without_times(one.record), without_times(two.record))
+    assert pd.testing.assert_frame_equal(threaded, run(two_shaft, variants), check_exact=True) is None

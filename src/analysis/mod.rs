@@ -78,6 +78,6 @@ pub use sweep_settings::{SweepSettings, SweepStart};
 pub use torus_lines::{line_label, LineRecord, Spectrum};
 pub use torus_solve::{torus_solve, BaseRecord, TorusSolveAnalysis, TorusSolveSettings, TOP_LINES};
 pub use torus_sweep::{
-    torus_sweep, OrderCut, TorusPointRecord, TorusSweepAnalysis, TorusSweepSettings,
-    CUTS_PER_ELEMENT,
+    check_torus_sweep, torus_sweep, OrderCut, TorusPointRecord, TorusSweepAnalysis,
+    TorusSweepSettings, CUTS_PER_ELEMENT,
 };

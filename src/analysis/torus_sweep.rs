@@ -101,22 +101,9 @@ impl TorusSweepAnalysis {
     }
 }
 
-/// Sweeps a torus scene over evenly spaced speeds; progress to `observer`.
-///
-/// ```
-/// use hbal::analysis::{torus_sweep, Silent, TorusSweepSettings};
-/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/two_stage_train_torus.toml");
-/// let scene = hbal::scene::Scene::load(std::path::Path::new(path)).unwrap();
-/// let settings = TorusSweepSettings { from: Some(2000.0), to: 2100.0, points: 3 };
-/// let a = torus_sweep(&scene, &settings, &mut Silent).unwrap();
-/// assert_eq!((a.points.len(), a.exit_code()), (3, 0));
-/// assert_eq!(a.order_cuts[0].amplitudes.len(), 3);
-/// ```
-pub fn torus_sweep(
-    scene: &Scene,
-    settings: &TorusSweepSettings,
-    observer: &mut dyn Observer,
-) -> Result<TorusSweepAnalysis> {
+/// Checks the options of a torus sweep of `scene` before any work: at least 2 points, `from`
+/// (default the scene's speed) and `to` finite speeds > 0.
+pub fn check_torus_sweep(scene: &Scene, settings: &TorusSweepSettings) -> Result<()> {
     let plan = plan_of(scene, "sweep")?;
     let from = settings.from.unwrap_or(plan.speed);
     if settings.points < 2 {
@@ -133,6 +120,28 @@ pub fn torus_sweep(
             });
         }
     }
+    Ok(())
+}
+
+/// Sweeps a torus scene over evenly spaced speeds; progress to `observer`.
+///
+/// ```
+/// use hbal::analysis::{torus_sweep, Silent, TorusSweepSettings};
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/two_stage_train_torus.toml");
+/// let scene = hbal::scene::Scene::load(std::path::Path::new(path)).unwrap();
+/// let settings = TorusSweepSettings { from: Some(2000.0), to: 2100.0, points: 3 };
+/// let a = torus_sweep(&scene, &settings, &mut Silent).unwrap();
+/// assert_eq!((a.points.len(), a.exit_code()), (3, 0));
+/// assert_eq!(a.order_cuts[0].amplitudes.len(), 3);
+/// ```
+pub fn torus_sweep(
+    scene: &Scene,
+    settings: &TorusSweepSettings,
+    observer: &mut dyn Observer,
+) -> Result<TorusSweepAnalysis> {
+    check_torus_sweep(scene, settings)?;
+    let plan = plan_of(scene, "sweep")?;
+    let from = settings.from.unwrap_or(plan.speed);
     let n = settings.points;
     let per = plan.rad_s_per_speed;
     let speeds: Vec<f64> = (0..n)

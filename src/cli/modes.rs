@@ -53,11 +53,11 @@ pub(crate) fn modes(path: &Path, args: &SolverArgs, opts: ModesOptions) -> Resul
     }
     if let Some(dir) = opts.out {
         let mut warnings = Vec::new();
-        hbal::render::write_modes_files(dir, &scene, &a, &mut warnings)
+        let written = hbal::render::write_modes_files(dir, &scene, &a, &mut warnings)
             .map_err(|e| super::failure(e, &scene.file))?;
         super::print_warnings(&warnings);
         if !as_json {
-            say!("  wrote modes.csv, campbell.svg to {}", dir.display());
+            say!("  wrote {} to {}", written.join(", "), dir.display());
         }
     }
     Ok(0)

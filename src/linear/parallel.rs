@@ -15,11 +15,7 @@ const MIN_WORK: usize = 20_000;
 /// Threads to use for `work` (DOFs × harmonics): `HBAL_THREADS` (default 1), at most the
 /// available cores, 1 for small problems.
 pub(crate) fn threads(work: usize) -> usize {
-    let asked = std::env::var("HBAL_THREADS")
-        .ok()
-        .and_then(|v| v.parse::<usize>().ok())
-        .filter(|&t| t >= 1)
-        .unwrap_or(1);
+    let asked = asked().unwrap_or(1);
     if work < MIN_WORK || asked == 1 {
         return 1;
     }
@@ -30,22 +26,47 @@ pub(crate) fn threads(work: usize) -> usize {
 /// Threads for a few long, independent tasks (tens of milliseconds each, where a busy core
 /// costs little against the spawn): `HBAL_THREADS` if set, otherwise every available core.
 pub(crate) fn threads_for_long_tasks() -> usize {
-    std::env::var("HBAL_THREADS")
+    asked().unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+std::thread_local! {
+    /// The limit of [`limit_threads_here`] on this thread.
+    static LIMIT: std::cell::Cell<Option<usize>> = const { std::cell::Cell::new(None) };
+}
+
+/// Limits the threads of the analyses started on the calling thread to `limit` (`None`: no
+/// limit of its own, `HBAL_THREADS` and the cores decide) and returns the limit before. A
+/// study that runs one analysis per core sets 1 in each task: every analysis keeps to its core
+/// (no second thread for the stability's products), with the same answers to the bit. Only
+/// this thread is affected, so analyses on other threads keep theirs.
+///
+/// ```
+/// let before = hbal::limit_threads_here(Some(1));
+/// assert_eq!(before, None);
+/// assert_eq!(hbal::limit_threads_here(before), Some(1));
+/// ```
+pub fn limit_threads_here(limit: Option<usize>) -> Option<usize> {
+    LIMIT.with(|l| l.replace(limit))
+}
+
+/// `HBAL_THREADS`, within the calling thread's limit ([`limit_threads_here`]).
+fn asked() -> Option<usize> {
+    let env = std::env::var("HBAL_THREADS")
         .ok()
         .and_then(|v| v.parse::<usize>().ok())
-        .filter(|&t| t >= 1)
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .filter(|&t| t >= 1);
+    match (LIMIT.with(|l| l.get()), env) {
+        (Some(limit), Some(t)) => Some(t.min(limit.max(1))),
+        (Some(limit), None) => Some(limit.max(1)),
+        (None, env) => env,
+    }
 }
 
 /// Whether an analysis may keep a second thread busy beside its own (the stability's
-/// assembler, a sweep's stability worker): `HBAL_THREADS` of 2 or more, or, where it is not
-/// set, at least two available cores. A study running one analysis per core sets
-/// `HBAL_THREADS=1`: each analysis then keeps to its core.
+/// assembler, a sweep's stability worker): `HBAL_THREADS` (within the thread's limit) of 2 or
+/// more, or, where neither is set, at least two available cores.
 pub(crate) fn second_thread() -> bool {
-    match std::env::var("HBAL_THREADS")
-        .ok()
-        .and_then(|v| v.parse::<usize>().ok())
-    {
+    match asked() {
         Some(t) => t >= 2,
         None => std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2),
     }

@@ -12,16 +12,24 @@ use std::f64::consts::TAU;
 use std::path::Path;
 
 /// Writes `modes.csv` and `campbell.svg` of `a` (the natural frequencies of `scene`) into
-/// `dir`; nothing where the operating point did not converge (no linearisation). A plot that
-/// cannot be drawn is a warning in `warnings`.
+/// `dir` and returns the names written; nothing where the operating point did not converge
+/// (no linearisation). A plot that cannot be drawn is a warning in `warnings`.
 pub fn write_modes_files(
     dir: &Path,
     scene: &Scene,
     a: &ModesAnalysis,
     warnings: &mut Vec<String>,
-) -> Result<()> {
-    let Some(nf) = &a.natural else { return Ok(()) };
-    write_outputs(dir, scene, a, nf, warnings).map_err(|e| cannot_write(dir, e))
+) -> Result<Vec<String>> {
+    let Some(nf) = &a.natural else {
+        return Ok(Vec::new());
+    };
+    let before = warnings.len();
+    write_outputs(dir, scene, a, nf, warnings).map_err(|e| cannot_write(dir, e))?;
+    let mut written = vec!["modes.csv".to_string()];
+    if warnings.len() == before {
+        written.push("campbell.svg".into());
+    }
+    Ok(written)
 }
 
 /// `modes.csv` (frequencies and shapes) and `campbell.svg`.

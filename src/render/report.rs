@@ -141,7 +141,8 @@ impl Report {
 /// `out/modes`). Bad input (the speeds, the output, an unusable `out`, a solve that cannot
 /// start) is an error before any work; a part that fails later is shown failed in the page
 /// and sets [`Report::exit_code`] to 1. The observer hears the stages and the run-up's
-/// progress.
+/// progress; a report cancelled through [`ReportSettings::cancel`] is [`Error::Cancelled`]
+/// before its page is written.
 pub fn report(
     scene: &Scene,
     scene_text: &str,
@@ -159,16 +160,29 @@ pub fn report(
     let mut warnings = Vec::new();
     observer.stage(&format!("solving {} at its speed", scene.file));
     let solved = solve_part(scene, settings, out, &mut warnings)?;
-    let swept = settings.to.map(|to| {
-        observer.stage(&format!(
-            "run-up to {} {}",
-            speed_text(to),
-            scene.speed_unit
-        ));
-        sweep_part(scene, settings, out, to, observer, &mut warnings)
-    });
+    let swept = match settings.to {
+        Some(to) => {
+            observer.stage(&format!(
+                "run-up to {} {}",
+                speed_text(to),
+                scene.speed_unit
+            ));
+            cancelled(settings)?;
+            Some(sweep_part(
+                scene,
+                settings,
+                out,
+                to,
+                observer,
+                &mut warnings,
+            ))
+        }
+        None => None,
+    };
     observer.stage("natural frequencies");
+    cancelled(settings)?;
     let moded = modes_part(scene, settings, out, &mut warnings);
+    cancelled(settings)?;
     let html = super::report_html::build(&super::report_html::Inputs {
         scene,
         scene_text,
@@ -196,6 +210,17 @@ pub fn report(
         warnings,
         exit_code: codes.into_iter().max().unwrap_or(0).min(1),
     })
+}
+
+/// [`Error::Cancelled`] where the caller cancelled the report (its observer or a failed law
+/// set [`ReportSettings::cancel`]): no page for a report stopped half way.
+pub(super) fn cancelled(settings: &ReportSettings) -> Result<()> {
+    if settings.cancel.is_cancelled() {
+        return Err(Error::Cancelled {
+            what: "the report".into(),
+        });
+    }
+    Ok(())
 }
 
 /// An [`Error::InvalidOptions`].
@@ -318,6 +343,6 @@ fn modes_part(
         analysis,
         ModesAnalysis::exit_code,
         &failed,
-        |a| super::write_modes_files(&dir, scene, a, warnings),
+        |a| super::write_modes_files(&dir, scene, a, warnings).map(|_| ()),
     )
 }

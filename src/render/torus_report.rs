@@ -4,7 +4,7 @@
 //! cuts, waterfall (sidebands included) and the points that did not converge. The parts' files
 //! go to `DIR/solve` and `DIR/sweep` as `hbal solve` and `hbal sweep` write them.
 
-use super::report::{options, Report, ReportParts, ReportSettings};
+use super::report::{cancelled, options, Report, ReportParts, ReportSettings};
 use super::{prepare_out, speed_text};
 use crate::analysis::{Observer, Spectrum, TorusSolveAnalysis, TorusSolveSettings};
 use crate::analysis::{TorusSweepAnalysis, TorusSweepSettings};
@@ -27,8 +27,16 @@ pub(super) fn report(
     dir: &Path,
     observer: &mut dyn Observer,
 ) -> Result<Report> {
-    let shown = match settings.to {
-        Some(_) => super::torus_shown(scene, settings.output.as_deref())?,
+    let sweep = settings.to.map(|to| TorusSweepSettings {
+        from: settings.from,
+        to,
+        points: RUN_UP_POINTS,
+    });
+    let shown = match &sweep {
+        Some(sweep) => {
+            crate::analysis::check_torus_sweep(scene, sweep)?;
+            super::torus_shown(scene, settings.output.as_deref())?
+        }
         None if settings.output.is_some() => {
             return Err(options("--output", "chooses the run-up's plots: give --to"))
         }
@@ -46,25 +54,22 @@ pub(super) fn report(
     ));
     let solved = crate::analysis::torus_solve(scene, &TorusSolveSettings::default())?;
     super::write_torus_solve_files(&dir.join("solve"), scene, &solved, &mut warnings)?;
-    let swept = match settings.to {
+    let swept = match &sweep {
         None => None,
-        Some(to) => {
+        Some(sweep) => {
             observer.stage(&format!(
                 "run-up to {} {}",
-                speed_text(to),
+                speed_text(sweep.to),
                 scene.speed_unit
             ));
-            let sweep = TorusSweepSettings {
-                from: settings.from,
-                to,
-                points: RUN_UP_POINTS,
-            };
-            let a = crate::analysis::torus_sweep(scene, &sweep, observer)?;
+            cancelled(settings)?;
+            let a = crate::analysis::torus_sweep(scene, sweep, observer)?;
             let out = dir.join("sweep");
             super::write_torus_sweep_files(&out, scene, &a, shown.as_deref(), &mut warnings)?;
             Some(a)
         }
     };
+    cancelled(settings)?;
     let page = page(scene, scene_text, dir, &solved, swept.as_ref());
     let file = dir.join("report.html");
     std::fs::write(&file, page).map_err(|e| super::cannot_write(dir, e))?;

@@ -258,10 +258,10 @@ pub(super) fn integrate_segment(
     let (mut t, mut y, mut next) = (ta, y, 0);
     // A fresh integrator from every restart (its first step chosen for what is left).
     for restarts in 0.. {
-        if restarts > MAX_RESTARTS {
+        if restarts >= MAX_RESTARTS {
             return Err(Error::TimeIntegration {
                 reason: format!(
-                    "a law with memory switched between holding and moving {MAX_RESTARTS} times within one segment at t = {t:.6e} s (it chatters: a contact or slider on an almost free or very stiff DOF); check the stiffness, masses and loads for a unit mistake, or skip the stability (--no-stability)"
+                    "a law with memory switched between holding and moving {MAX_RESTARTS} times within one segment at t = {t:.6e} s (it chatters: a contact or slider on an almost free or very stiff DOF); check the stiffness, masses and loads for a unit mistake (in a stability computation, --no-stability skips it)"
                 ),
             });
         }
