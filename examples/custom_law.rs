@@ -4,8 +4,16 @@
 //! off. The example implements [`ForceLaw`], checks its derivatives, gives it a scene-file name,
 //! solves the periodic response by harmonic balance and checks it against the time domain.
 //!
-//! Run: `cargo run --release --example custom_law`. The same file compiles as the `main.rs` of
-//! a crate of your own with only these dependencies (CI builds it that way):
+//! Run: `cargo run --release --example custom_law`. With arguments the program is the whole
+//! `hbal` command line with this law among the scene types ([`hbal::cli::main`]: solve, sweep,
+//! report, plots), e.g. on the scene `examples/custom_law_hertz.toml`:
+//!
+//! ```text
+//! cargo run --release --example custom_law -- report examples/custom_law_hertz.toml --from 0.3 --to 1.2 --out out/hertz
+//! ```
+//!
+//! The same file compiles as the `main.rs` of a crate of your own with only these dependencies
+//! (CI builds it that way and runs its `report`):
 //!
 //! ```toml
 //! [dependencies]
@@ -60,7 +68,11 @@ impl ForceLaw for HertzContact {
     }
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> Result<std::process::ExitCode, Box<dyn std::error::Error>> {
+    // With arguments: the `hbal` command line, which reads `type = "hertz_contact"` in scenes.
+    if std::env::args_os().len() > 1 {
+        return Ok(hbal::cli::main());
+    }
     // Preload F0 = 1 on k_h = 1: static deflection (F0/k_h)^(2/3) = 1 beyond the clearance.
     let (k_h, b, f0, f1, c) = (1.0, 0.1, 1.0, 0.3, 0.1);
     let law = HertzContact {
@@ -145,5 +157,5 @@ u_op = {u_op}
     if !sol.is_converged() || err > 1e-6 {
         return Err(format!("HB and the time domain disagree: {err:.2e}").into());
     }
-    Ok(())
+    Ok(std::process::ExitCode::SUCCESS)
 }

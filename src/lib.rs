@@ -52,8 +52,12 @@
 //! ```
 #![warn(missing_docs)]
 
+// `hbal::...` paths inside the crate too (the command line's modules are written with them).
+extern crate self as hbal;
+
 pub mod analysis;
 pub mod catalog;
+pub mod cli;
 pub mod compare;
 pub mod continuation;
 pub mod error;

@@ -1,7 +1,21 @@
-//! Shared pieces of the `hbal` subcommands: the `say!` macro, the `Failure` error with its
-//! exit code, the solver overrides shared by `solve`, `compare` and `sweep` (`--method`,
-//! `--harmonics`, `--samples`, `--tolerance`) and scene loading with them, and the JSON of
-//! Floquet multipliers. Each subcommand lives in its own file below.
+//! The `hbal` command line: [`main`] runs it, in hbal's own binary or in a user's crate with
+//! force laws of its own (a law registered with `#[typetag::serde(name = "...")]` is a scene
+//! `type` like the built-ins; see `examples/custom_law_cli.rs`):
+//!
+//! ```no_run
+//! fn main() -> std::process::ExitCode {
+//!     hbal::cli::main()
+//! }
+//! ```
+//!
+//! Exit codes: 0 success, 1 a numerical failure: a solve that did not converge, a branch that
+//! stopped before `--to`, a failed stability computation (the partial result is still reported
+//! and written), 2 bad input (the message names the file and the field).
+//!
+//! Below: the subcommands' flags (`command.rs`) and one file per subcommand; shared here: the
+//! `say!` macro, the `Failure` error with its exit code, the solver overrides shared by
+//! `solve`, `compare` and `sweep` (`--method`, `--harmonics`, `--samples`, `--tolerance`) and
+//! scene loading with them.
 
 use hbal::scene::Scene;
 use std::path::Path;
@@ -19,6 +33,7 @@ macro_rules! say {
 }
 
 pub(crate) mod check;
+mod command;
 pub(crate) mod compare;
 pub(crate) mod dof_selection;
 pub(crate) mod element_report;
@@ -36,6 +51,16 @@ pub(crate) mod sweep_summary;
 mod sweep_text;
 pub(crate) mod torus_solve;
 pub(crate) mod torus_sweep;
+
+/// Runs the `hbal` command line on the process's arguments (`hbal solve SCENE`, `sweep`,
+/// `report`, ...) and returns its exit code. A panic is one line on stderr, not a backtrace.
+pub fn main() -> std::process::ExitCode {
+    // A bug must not greet a user with a backtrace: one line, and where to report it.
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!("error: internal error in hbal ({info}); please report it with the scene file");
+    }));
+    command::run()
+}
 
 /// An error with its exit code.
 pub(crate) struct Failure {
