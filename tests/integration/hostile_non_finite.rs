@@ -182,3 +182,29 @@ fn a_chattering_slider_stops_the_shooting_with_its_reason() {
     assert_eq!(doc["converged"], true, "the solve itself stands");
     let _ = std::fs::remove_dir_all(temp_dir());
 }
+
+/// The scenes on several base frequencies print `caps_stopped: null` (the caps met their
+/// tolerance) and, in a sweep, `bases[].hz: null`: documented nulls, not non-finite numbers
+/// (the hostile property test met them on the planetary set).
+#[test]
+fn torus_documents_have_only_documented_nulls() {
+    for name in ["planetary_set.toml", "two_stage_train_torus.toml"] {
+        let file = write(&temp_dir(), name, &example(name));
+        let run = run_limited(&["solve", "--json", &file]);
+        assert_eq!(run.code, Some(0), "{name}: {}", run.stderr);
+        assert!(run.stdout.contains("\"caps_stopped\":null"), "{name}");
+        judge_document(&run, Document::Solve).unwrap_or_else(|(b, w)| panic!("{name}: {b:?}: {w}"));
+    }
+    let file = write(
+        &temp_dir(),
+        "torus.toml",
+        &example("two_stage_train_torus.toml"),
+    );
+    let args = [
+        "sweep", "--json", &file, "--from", "1000", "--to", "1100", "--points", "2",
+    ];
+    let run = run_limited(&args);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    judge_document(&run, Document::Sweep).unwrap_or_else(|(b, w)| panic!("sweep: {b:?}: {w}"));
+    let _ = std::fs::remove_dir_all(temp_dir());
+}

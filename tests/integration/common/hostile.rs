@@ -91,7 +91,7 @@ pub enum Breach {
 }
 
 /// Keys whose value may be `null` by the documented schema (docs/scenes.md).
-const NULLABLE: [&str; 33] = [
+const NULLABLE: [&str; 35] = [
     "auto_harmonics",
     "error_estimate",
     "found_by",
@@ -127,6 +127,10 @@ const NULLABLE: [&str; 33] = [
     "lower_hz",
     "upper_hz",
     "worst_quantity_vs_time_domain",
+    // Several base frequencies: why the automatic caps stopped (none: null); a base's Hz in a
+    // sweep, where the speed varies (docs/torus.md).
+    "caps_stopped",
+    "hz",
 ];
 
 /// Judges a run of `hbal check` (`json = false`) or `hbal solve --json` (`json = true`).
@@ -201,7 +205,10 @@ pub fn judge_document(run: &Run, document: Document) -> Result<(), (Breach, Stri
     }
     if document != Document::Solve {
         let expected = match document {
-            Document::Sweep => doc["reached"].as_bool().map(|r| if r { 0 } else { 1 }),
+            Document::Sweep => doc["reached"]
+                .as_bool()
+                .map(|r| if r { 0 } else { 1 })
+                .or_else(|| torus_sweep_verdict(&doc)),
             Document::Modes => doc["converged"].as_bool().map(|c| if c { 0 } else { 1 }),
             _ => doc["methods"].as_array().map(|m| {
                 let any = m.iter().any(|m| m["converged"] == true);
@@ -239,6 +246,16 @@ pub fn judge_document(run: &Run, document: Document) -> Result<(), (Breach, Stri
         );
     }
     Ok(())
+}
+
+/// The exit code a sweep on several base frequencies says it has (it has no `reached`): 1
+/// where a point did not converge, a speed was skipped or the caps stopped short.
+fn torus_sweep_verdict(doc: &serde_json::Value) -> Option<i32> {
+    let points = doc["points"].as_array()?;
+    let failed = points.iter().any(|p| p["converged"] != true)
+        || doc["skipped"].as_array().is_some_and(|s| !s.is_empty())
+        || !doc["caps_stopped"].is_null();
+    Some(i32::from(failed))
 }
 
 /// The path of the first `null` outside the nullable keys.
