@@ -56,7 +56,7 @@ pub struct ModesAnalysis {
     pub natural: Option<NaturalFrequencies>,
     /// The excitation orders of the reference speed.
     pub orders: Vec<f64>,
-    /// The critical speeds in the range, by order and mode.
+    /// The critical speeds in the range, by speed (as a run-up meets them).
     pub critical: Vec<CriticalSpeed>,
     /// The DOF names (the rows of the shapes).
     pub dofs: Vec<String>,
@@ -224,7 +224,7 @@ fn critical_speeds(
     (from, to): (f64, f64),
 ) -> Vec<CriticalSpeed> {
     let elastic = || nf.mean.iter().enumerate().filter(|(_, f)| **f > 0.0);
-    orders
+    let mut critical = orders
         .iter()
         .flat_map(|&order| {
             elastic().map(move |(i, &f)| CriticalSpeed {
@@ -234,7 +234,10 @@ fn critical_speeds(
             })
         })
         .filter(|c| c.speed >= from && c.speed <= to)
-        .collect()
+        .collect::<Vec<_>>();
+    // By speed, as a run-up meets them (ties by order, then mode).
+    critical.sort_by(|a, b| a.speed.total_cmp(&b.speed));
+    critical
 }
 
 impl ModesAnalysis {

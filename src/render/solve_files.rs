@@ -126,7 +126,7 @@ fn write_outputs(
 ) -> anyhow::Result<Vec<String>> {
     std::fs::create_dir_all(dir)?;
     let file = |name: &str| dir.join(format!("{}{name}", label.prefix));
-    harmonics_csv(&file("harmonics.csv"), sol, order)?;
+    harmonics_csv(&file("harmonics.csv"), sol, &order)?;
     let series: Vec<Vec<f64>> = series.unwrap_or_else(|| {
         let points = sol.basis().samples().max(256);
         (0..sol.dof_names().len())
@@ -152,7 +152,7 @@ fn write_outputs(
         "{}: amplitude spectrum (static part omitted){note}",
         label.title
     );
-    if let Some(plot) = spectrum_plot(&file("spectrum.svg"), sol, &shown, &title) {
+    if let Some(plot) = spectrum_plot(&file("spectrum.svg"), sol, &shown, &title, &order) {
         plotted("spectrum.svg", plot);
     }
     Ok(written)
@@ -224,13 +224,15 @@ fn time_series_plot(
     line_plot(path, title, &x, &y, &lines)
 }
 
-/// The amplitude spectrum of the `shown` DOFs; `None` for a static solution (every harmonic
-/// k >= 1 zero), which has none.
+/// The amplitude spectrum of the `shown` DOFs over the order of the reference shaft
+/// (`order(k)` of harmonic k: the engine order where the scene's speed is the crankshaft's);
+/// `None` for a static solution (every harmonic k >= 1 zero), which has none.
 fn spectrum_plot(
     path: &Path,
     sol: &Solution,
     shown: &[usize],
     title: &str,
+    order: &dyn Fn(usize) -> f64,
 ) -> Option<std::result::Result<(), Box<dyn std::error::Error>>> {
     let h = sol.basis().harmonics();
     // Amplitudes below 1e-13 of the largest are rounding noise: left out.
@@ -244,14 +246,15 @@ fn spectrum_plot(
     let spectra: Vec<Series> = shown
         .iter()
         .map(|&i| {
-            let ks = (1..=h).map(|k| (k as f64, sol.harmonic(i, k).norm()));
+            let ks = (1..=h).map(|k| (order(k), sol.harmonic(i, k).norm()));
             Series::markers(
                 sol.dof_names()[i].clone(),
                 ks.filter(|&(_, a)| a > 1e-13 * largest).collect(),
             )
         })
         .collect();
-    let (x, y) = (Axis::linear("harmonic k"), Axis::log("|q_k| (rad or m)"));
+    let x = Axis::linear("order of the reference shaft");
+    let y = Axis::log("|q_k| (rad or m)");
     Some(line_plot(path, title, &x, &y, &spectra))
 }
 

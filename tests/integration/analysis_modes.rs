@@ -59,3 +59,30 @@ fn the_cli_json_is_the_serialised_library_modes() {
     assert!(e.to_string().contains("need 0 <= from < to"), "{e}");
     assert_eq!(e.exit_code(), 2);
 }
+
+/// The critical speeds come by speed, as a run-up meets them (issue 36; they came by order):
+/// on the free-free drivetrain orders 1.5, 2 and 3 meet modes 3 and 4 interleaved.
+#[test]
+fn critical_speeds_come_by_speed() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/free_free_drivetrain.toml");
+    let scene = Scene::load(&path).unwrap();
+    let settings = ModesSettings {
+        from: Some(800.0),
+        to: Some(6000.0),
+        ..ModesSettings::default()
+    };
+    let a = modes(&scene, &settings).unwrap();
+    let speeds: Vec<f64> = a.critical.iter().map(|c| c.speed).collect();
+    assert!(speeds.len() >= 6, "{speeds:?}");
+    assert!(speeds.windows(2).all(|w| w[0] <= w[1]), "{speeds:?}");
+    // Not by order: a lower order comes after a higher one somewhere.
+    assert!(a.critical.windows(2).any(|w| w[1].order < w[0].order));
+    // Order 3 meets mode 3 first, at 960 rpm.
+    assert_eq!((a.critical[0].order, a.critical[0].mode), (3.0, 3));
+    assert!(
+        (a.critical[0].speed - 960.29).abs() < 0.01,
+        "{}",
+        a.critical[0].speed
+    );
+}

@@ -94,3 +94,25 @@ fn bad_report_input_is_an_input_error_before_anything_is_written() {
         assert!(!dir.exists(), "nothing written for `{says}`");
     }
 }
+
+/// The spectrum's x axis is the order of the reference shaft (issue 36): on the clutch damper
+/// (fundamental = engine order 2, H = 24) it reaches order 48, past the harmonic index.
+#[test]
+fn the_spectrum_is_over_the_shaft_order() {
+    let scene = load("clutch_damper_hysteresis.toml");
+    let a = solve(&scene, &SolveSettings::default()).expect("solve");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_library_spectrum");
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut warnings = Vec::new();
+    hbal::render::write_solve_files(&scene, &a, &dir, &mut warnings).expect("files");
+    let svg = std::fs::read_to_string(dir.join("spectrum.svg")).expect("spectrum.svg");
+    assert!(svg.contains("order of the reference shaft"), "axis label");
+    assert!(!svg.contains("harmonic k"));
+    // A tick beyond H = 24: the axis spans the orders 2..48.
+    let ticks: Vec<f64> = svg
+        .split('>')
+        .filter_map(|t| t.split('<').next()?.trim().parse::<f64>().ok())
+        .collect();
+    assert!(ticks.iter().any(|&t| t >= 40.0), "{ticks:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
