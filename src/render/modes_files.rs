@@ -6,6 +6,7 @@
 use super::cannot_write;
 use crate::analysis::ModesAnalysis;
 use crate::error::Result;
+use crate::report::csv_number;
 use crate::report::{line_plot, Axis, NaturalFrequencies, Series};
 use crate::scene::Scene;
 use std::f64::consts::TAU;
@@ -54,11 +55,11 @@ fn write_outputs(
     for (i, f) in nf.mean.iter().enumerate() {
         let mut row = vec![
             (i + 1).to_string(),
-            format!("{f:e}"),
-            format!("{:e}", nf.lower.get(i).copied().unwrap_or(f64::NAN)),
-            format!("{:e}", nf.upper.get(i).copied().unwrap_or(f64::NAN)),
+            csv_number(*f),
+            csv_number(nf.lower.get(i).copied().unwrap_or(f64::NAN)),
+            csv_number(nf.upper.get(i).copied().unwrap_or(f64::NAN)),
         ];
-        row.extend(nf.shapes.column(i).iter().map(|v| format!("{v:e}")));
+        row.extend(nf.shapes.column(i).iter().map(|v| csv_number(*v)));
         w.write_record(&row)?;
     }
     w.flush()?;

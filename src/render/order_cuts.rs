@@ -8,6 +8,7 @@
 
 use crate::analysis::{Shown, SweepAnalysis};
 use crate::continuation::{Branch, BranchPoint};
+use crate::report::csv_number;
 use crate::report::{line_plot, waterfall_plot, Axis, ElementOutput, Series, Slice, Waterfall};
 use crate::scene::Scene;
 use std::path::Path;
@@ -193,7 +194,7 @@ fn csv_of(
     );
     w.write_record(&header)?;
     for (p, outputs) in branch.points.iter().zip(outputs) {
-        let mut row = vec![format!("{:e}", speed(p.omega))];
+        let mut row = vec![csv_number(speed(p.omega))];
         let harmonic_of = |name: usize, k: usize| {
             if name < dof_columns {
                 p.harmonics[k * n + dofs[name]]
@@ -204,14 +205,14 @@ fn csv_of(
         for name in 0..names.len() {
             for &(_, k) in orders {
                 let x = harmonic_of(name, k);
-                row.push(format!("{:e}", x.norm()));
+                row.push(csv_number(x.norm()));
                 // q = Re(Q e^{ikθ}) = |Q| cos(kθ + arg Q).
-                row.push(format!("{:e}", x.arg().to_degrees()));
+                row.push(csv_number(x.arg().to_degrees()));
             }
         }
         for &i in &contacts {
             let open = outputs[i].states.iter().find(|(s, _)| s == "open");
-            row.push(open.map_or(String::new(), |(_, f)| format!("{f:e}")));
+            row.push(open.map_or(String::new(), |(_, f)| csv_number(*f)));
         }
         w.write_record(&row)?;
     }

@@ -7,6 +7,7 @@
 use super::{cannot_write, speed_text};
 use crate::analysis::{order_of, SolveAnalysis};
 use crate::error::Result;
+use crate::report::csv_number;
 use crate::report::{line_plot, Axis, ElementOutput, Series};
 use crate::scene::Scene;
 use crate::Solution;
@@ -103,8 +104,8 @@ pub fn element_csv(
                     quantity.to_string(),
                     k.to_string(),
                     format!("{}", order(k)),
-                    format!("{c:e}"),
-                    format!("{sn:e}"),
+                    csv_number(c),
+                    csv_number(sn),
                 ])?;
             }
         }
@@ -170,8 +171,8 @@ fn harmonics_csv(path: &Path, sol: &Solution, order: impl Fn(usize) -> f64) -> a
                 name.clone(),
                 k.to_string(),
                 order(k).to_string(),
-                format!("{c:e}"),
-                format!("{s:e}"),
+                csv_number(c),
+                csv_number(s),
             ];
             w.write_record(row)?;
         }
@@ -190,10 +191,10 @@ fn time_series_csv(path: &Path, sol: &Solution, series: &[Vec<f64>]) -> anyhow::
     for j in 0..points {
         let frac = j as f64 / points as f64;
         let mut row = vec![
-            format!("{:e}", frac * period),
-            format!("{:e}", frac * std::f64::consts::TAU),
+            csv_number(frac * period),
+            csv_number(frac * std::f64::consts::TAU),
         ];
-        row.extend(series.iter().map(|s| format!("{:e}", s[j])));
+        row.extend(series.iter().map(|s| csv_number(s[j])));
         w.write_record(&row)?;
     }
     Ok(w.flush()?)

@@ -5,6 +5,7 @@
 use super::cannot_write;
 use crate::analysis::TorusSolveAnalysis;
 use crate::error::Result;
+use crate::report::csv_number;
 use crate::report::{line_plot, Axis, Series};
 use crate::scene::Scene;
 use std::path::Path;
@@ -40,10 +41,10 @@ fn write_lines(path: &Path, a: &TorusSolveAnalysis) -> anyhow::Result<()> {
                 crate::analysis::line_label(&sol.bases, k),
             ];
             row.extend(k.iter().map(|k| k.to_string()));
-            row.push(format!("{order:e}"));
-            row.push(format!("{:e}", order * sol.omega / std::f64::consts::TAU));
-            row.push(format!("{:e}", q.norm()));
-            row.push(format!("{:e}", q.arg().to_degrees()));
+            row.push(csv_number(order));
+            row.push(csv_number(order * sol.omega / std::f64::consts::TAU));
+            row.push(csv_number(q.norm()));
+            row.push(csv_number(q.arg().to_degrees()));
             w.write_record(&row)?;
         }
     }

@@ -6,6 +6,7 @@
 use super::{cannot_write, speed_text};
 use crate::analysis::TorusSweepAnalysis;
 use crate::error::{Error, Result};
+use crate::report::csv_number;
 use crate::report::{line_plot, waterfall_plot, Axis, Series, Slice, Waterfall};
 use crate::scene::Scene;
 use std::path::Path;
@@ -63,15 +64,15 @@ fn write_files(
     w.write_record(&header)?;
     for p in &a.points {
         let mut row = vec![
-            format!("{:e}", p.speed),
+            csv_number(p.speed),
             p.converged.to_string(),
-            format!("{:e}", p.relative_residual),
+            csv_number(p.relative_residual),
             p.iterations.to_string(),
         ];
         row.extend(
             p.estimates
                 .iter()
-                .map(|e| e.map_or(String::new(), |e| format!("{e:e}"))),
+                .map(|e| e.map_or(String::new(), csv_number)),
         );
         w.write_record(&row)?;
     }
@@ -88,11 +89,11 @@ fn write_files(
     for c in &a.order_cuts {
         for (p, amp) in a.points.iter().zip(&c.amplitudes) {
             w.write_record([
-                format!("{:e}", p.speed),
+                csv_number(p.speed),
                 c.element.clone(),
                 c.label.clone(),
-                format!("{:e}", c.order),
-                format!("{amp:e}"),
+                csv_number(c.order),
+                csv_number(*amp),
                 p.converged.to_string(),
             ])?;
         }

@@ -1,6 +1,7 @@
 //! Branch reports: CSV and the frequency-response plot (stable solid, unstable dashed, folds
 //! marked).
 
+use super::csv_number;
 use super::{line_plot, Axis, Series};
 use crate::continuation::Branch;
 use std::path::Path;
@@ -78,16 +79,14 @@ pub fn branch_csv_of_dofs(
             None => "",
         };
         let mut row = vec![
-            format!("{:e}", parameter(p.parameter)),
+            csv_number(parameter(p.parameter)),
             stable.to_string(),
             p.fold.to_string(),
             p.bifurcation.map(|b| format!("{b:?}")).unwrap_or_default(),
         ];
-        row.extend(p.max_abs.iter().map(|m| format!("{m:e}")));
+        row.extend(p.max_abs.iter().map(|m| csv_number(*m)));
         for &i in amplitudes.iter().filter(|&&i| i < n) {
-            row.extend(
-                (0..=branch.harmonics).map(|k| format!("{:e}", p.harmonics[k * n + i].norm())),
-            );
+            row.extend((0..=branch.harmonics).map(|k| csv_number(p.harmonics[k * n + i].norm())));
         }
         let mult: Vec<String> = p
             .floquet
@@ -95,20 +94,20 @@ pub fn branch_csv_of_dofs(
             .flat_map(|f| f.multipliers.iter().map(|m| format!("{:.6e}", m.norm())))
             .collect();
         row.push(mult.join(";"));
-        row.push(format!("{:e}", p.residual));
-        row.push(format!("{:e}", p.truncation));
+        row.push(csv_number(p.residual));
+        row.push(csv_number(p.truncation));
         row.push(match (p.fold, p.fold_omega) {
-            (true, Some(w)) => format!("{:e}", parameter(w)),
+            (true, Some(w)) => csv_number(parameter(w)),
             _ => String::new(),
         });
         row.push(p.spurious_turn.to_string());
         row.push(
             p.bifurcation_omega
-                .map(|w| format!("{:e}", parameter(w)))
+                .map(|w| csv_number(parameter(w)))
                 .unwrap_or_default(),
         );
         for e in [p.error_estimate, p.error_estimate_harmonics] {
-            row.push(e.map(|e| format!("{e:e}")).unwrap_or_default());
+            row.push(e.map(csv_number).unwrap_or_default());
         }
         let _ = w.write_record(&row);
     }

@@ -1,6 +1,7 @@
 //! Reports: element outputs, SVG plots, the HTML report and timing for tables.
 
 mod branch;
+mod csv_number;
 mod element_output;
 mod element_report;
 mod html;
@@ -10,6 +11,7 @@ mod timing;
 mod waterfall;
 
 pub use branch::{branch_csv, branch_csv_of_dofs, branch_csv_orders, branch_plot, branches_plot};
+pub use csv_number::csv_number;
 pub use element_output::{element_outputs, ElementOutput, MeshOutput, Signal};
 pub use element_report::ElementReport;
 pub use html::{escape, HtmlReport};

@@ -116,3 +116,47 @@ fn the_spectrum_is_over_the_shaft_order() {
     assert!(ticks.iter().any(|&t| t >= 40.0), "{ticks:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The CSV files read as an engineer expects (issue 36): a speed computed as `ω / (rad/s per
+/// rpm)` is `6e3`, not `6.000000000000001e3`; a zero is `0`, never `-0e0`.
+#[test]
+fn csv_numbers_are_clean() {
+    let scene = load("two_shaft_6000rpm.toml");
+    let settings = hbal::analysis::SweepSettings {
+        stability: false,
+        max_points: Some(4),
+        ..hbal::analysis::SweepSettings::to(6100.0)
+    };
+    let a = hbal::analysis::sweep(&scene, &settings, &mut Silent).expect("sweep");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_library_csv");
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut warnings = Vec::new();
+    hbal::render::write_sweep_files(&dir, &scene, &a, &mut warnings).expect("sweep files");
+    let solved = solve(&scene, &SolveSettings::default()).expect("solve");
+    hbal::render::write_solve_files(&scene, &solved, &dir, &mut warnings).expect("solve files");
+    let branch = std::fs::read_to_string(dir.join("branch.csv")).expect("branch.csv");
+    let first = branch.lines().nth(1).expect("a point");
+    assert!(first.starts_with("6e3,"), "{first}");
+    for file in [
+        "branch.csv",
+        "order_cuts.csv",
+        "harmonics.csv",
+        "time_series.csv",
+        "elements.csv",
+    ] {
+        let text = std::fs::read_to_string(dir.join(file)).expect(file);
+        for cell in text.lines().skip(1).flat_map(|l| l.split(',')) {
+            assert!(!cell.starts_with("-0e") && cell != "-0", "{file}: {cell}");
+            if let Some((mantissa, _)) = cell.split_once('e') {
+                let digits = mantissa.chars().filter(char::is_ascii_digit).count();
+                assert!(digits <= 15, "{file}: {cell}");
+            }
+        }
+    }
+    let harmonics = std::fs::read_to_string(dir.join("harmonics.csv")).expect("harmonics.csv");
+    assert!(
+        harmonics.lines().any(|l| l.ends_with(",0")),
+        "the sin of harmonic 0 is 0"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
