@@ -44,6 +44,9 @@ def report(
     start: float | None = None,
     stability: bool = True,
     output: str | None = None,
+    max_step: float | None = None,
+    max_points: int | None = None,
+    points: int | None = None,
     method: str | None = None,
     harmonics: int | str | None = None,
     samples: int | None = None,
@@ -52,7 +55,9 @@ def report(
     progress: Callable[[float, str], None] | None = None,
 ) -> ReportResult:
     """Writes the report of ``scene`` into the directory ``out`` (``hbal report``); with
-    ``to`` (and ``start``, default the scene's speed) a run-up. ``stability=False`` is
+    ``to`` (and ``start``, default the scene's speed) a run-up, resolved by ``max_step`` (the
+    largest continuation step, default 0.5: smaller gives more points), ``max_points`` and
+    ``points`` (evenly spaced speeds on several base frequencies). ``stability=False`` is
     ``--no-stability``, ``output`` chooses the run-up's plotted output. ``progress(fraction,
     stage)`` hears the stages and the run-up; Ctrl-C stops the run-up and raises
     ``KeyboardInterrupt``. Bad input (the speeds, ``output``, an unusable ``out``) raises
@@ -69,6 +74,9 @@ def report(
         start=None if start is None else float(start),
         stability=_flag("stability", stability),
         output=output,
+        max_step=None if max_step is None else float(max_step),
+        max_points=_count("max_points", max_points),
+        points=_count("points", points),
         method=method,
         harmonics=harmonics,
         samples=_count("samples", samples),

@@ -18,7 +18,8 @@ type Returned = (String, u8, Vec<String>, Vec<String>, f64);
 /// The report of `scene` into `out`.
 #[pyfunction]
 #[pyo3(signature = (scene, out, *, to=None, start=None, stability=true, output=None,
-    method=None, harmonics=None, samples=None, tolerance=None, formulation=None, progress=None))]
+    max_step=None, max_points=None, points=None, method=None, harmonics=None, samples=None,
+    tolerance=None, formulation=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn report<'py>(
     py: Python<'py>,
@@ -28,6 +29,9 @@ pub fn report<'py>(
     start: Option<f64>,
     stability: bool,
     output: Option<String>,
+    max_step: Option<f64>,
+    max_points: Option<usize>,
+    points: Option<usize>,
     method: Option<String>,
     harmonics: Option<&Bound<'py, PyAny>>,
     samples: Option<usize>,
@@ -52,6 +56,13 @@ pub fn report<'py>(
         output,
         formulation: o.formulation,
         tolerance,
+        max_step,
+        max_points: max_points
+            .map(|n| crate::options::points_in_range("max_points", n, 1))
+            .transpose()?,
+        points: points
+            .map(|n| crate::options::points_in_range("points", n, 2))
+            .transpose()?,
         cancel: observer.cancel.clone(),
     };
     let started = std::time::Instant::now();

@@ -157,3 +157,20 @@ def test_out_paths_that_cannot_be_used(tmp_path):
             hbal.solve(scene, out=bad)
     r = hbal.solve(scene, out=os.fsencode(str(tmp_path / "bytes")))
     assert (tmp_path / "bytes" / "harmonics.csv").exists() and r.exit_code == 0
+
+
+def test_the_report_run_up_resolution(tmp_path, hbal_bin):
+    path = scene_path("gear_backlash.toml")
+    run = cli_out(hbal_bin, "report", path, "--to", "0.9", "--max-step", "0.1", "--out", str(tmp_path / "cli"))
+    assert run.returncode == 0, run.stderr
+    r = hbal.report(path, tmp_path / "py", to=0.9, max_step=0.1)
+    assert r.exit_code == 0
+    assert_same_files(tmp_path / "py", tmp_path / "cli")
+    coarse = hbal.report(path, tmp_path / "coarse", to=0.9)
+    rows = lambda d: len((d / "sweep" / "branch.csv").read_text().splitlines())
+    assert rows(tmp_path / "py") > rows(tmp_path / "coarse") and coarse.exit_code == 0
+    with pytest.raises(hbal.InputError, match="`max_step`"):
+        hbal.report(path, tmp_path / "bad", to=0.9, max_step=0.0)
+    with pytest.raises(hbal.InputError, match="points"):
+        hbal.report(path, tmp_path / "bad", to=0.9, max_points=0)
+    assert not (tmp_path / "bad").exists()

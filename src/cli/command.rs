@@ -107,6 +107,17 @@ enum Command {
         /// Skip the Floquet stability.
         #[arg(long)]
         no_stability: bool,
+        /// The run-up's largest continuation step (scaled arclength; default 0.5; smaller
+        /// gives more points).
+        #[arg(long, allow_negative_numbers = true)]
+        max_step: Option<f64>,
+        /// Stop the run-up after this many points (default 2000).
+        #[arg(long, value_parser = cli::sweep_command::sweep_points(1))]
+        max_points: Option<usize>,
+        /// Evenly spaced speeds of the run-up on several base frequencies (default 101) or
+        /// with the exact piecewise method.
+        #[arg(long, value_parser = cli::sweep_command::sweep_points(2))]
+        points: Option<usize>,
         #[command(flatten)]
         solver: cli::SolverArgs,
     },
@@ -154,6 +165,9 @@ pub(crate) fn run() -> ExitCode {
             out,
             output,
             no_stability,
+            max_step,
+            max_points,
+            points,
             solver,
         } => cli::report::report(
             &scene,
@@ -164,6 +178,7 @@ pub(crate) fn run() -> ExitCode {
                 stability: !no_stability,
                 out: &out,
                 output: output.as_deref(),
+                resolution: (max_step, max_points, points),
             },
         ),
         Command::Modes {

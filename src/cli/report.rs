@@ -14,6 +14,8 @@ pub(crate) struct ReportOptions<'a> {
     pub(crate) stability: bool,
     pub(crate) out: &'a Path,
     pub(crate) output: Option<&'a str>,
+    /// The run-up's `--max-step`, `--max-points` and `--points`.
+    pub(crate) resolution: (Option<f64>, Option<usize>, Option<usize>),
 }
 
 /// The stages on stderr (`report: solving ...`).
@@ -35,6 +37,9 @@ pub(crate) fn report(path: &Path, args: &SolverArgs, opts: ReportOptions) -> Res
         output: opts.output.map(str::to_string),
         formulation: args.formulation,
         tolerance: args.tolerance,
+        max_step: opts.resolution.0,
+        max_points: opts.resolution.1,
+        points: opts.resolution.2,
         ..ReportSettings::default()
     };
     let r = hbal::render::report(&scene, &scene_text, &settings, opts.out, &mut Stages)

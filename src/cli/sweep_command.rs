@@ -17,7 +17,7 @@ fn parse_orbit(s: &str) -> Result<hbal::stability::Orbit, String> {
 }
 
 /// A point count from `min` to [`MAX_SWEEP_POINTS`].
-fn sweep_points(min: u64) -> clap::builder::RangedU64ValueParser<usize> {
+pub(crate) fn sweep_points(min: u64) -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::new().range(min..=MAX_SWEEP_POINTS)
 }
 

@@ -32,6 +32,14 @@ pub struct ReportSettings {
     pub formulation: Formulation,
     /// The run-up's solver tolerance (default: the scene's).
     pub tolerance: Option<f64>,
+    /// The run-up's largest continuation step (scaled arclength; default 0.5: smaller gives
+    /// more points).
+    pub max_step: Option<f64>,
+    /// The run-up's point limit (default the continuation's).
+    pub max_points: Option<usize>,
+    /// The run-up's evenly spaced speeds where it has them (several base frequencies: default
+    /// 101; the exact piecewise method).
+    pub points: Option<usize>,
     /// Stops the run-up at its next point (its branch so far is reported).
     pub cancel: crate::continuation::Cancel,
 }
@@ -241,6 +249,9 @@ fn check(scene: &Scene, settings: &ReportSettings, out: &Path) -> Result<()> {
             crate::analysis::check_speed(scene, name, v, false)?;
         }
     }
+    if let Some(to) = settings.to {
+        crate::analysis::check_sweep(scene, &sweep_settings(settings, to))?;
+    }
     crate::analysis::shown_output(scene, settings.output.as_deref())?;
     for dof in scene.model.dof_names() {
         super::file_name_part(dof, "DOF")?;
@@ -281,6 +292,23 @@ fn solve_part(
     ))
 }
 
+/// The run-up's settings: the report's, the sweep's defaults for the rest.
+fn sweep_settings(settings: &ReportSettings, to: f64) -> SweepSettings {
+    let defaults = SweepSettings::to(to);
+    SweepSettings {
+        from: settings.from,
+        stability: settings.stability,
+        formulation: settings.formulation,
+        tolerance: settings.tolerance,
+        output: settings.output.clone(),
+        cancel: settings.cancel.clone(),
+        max_step: settings.max_step.unwrap_or(defaults.max_step),
+        max_points: settings.max_points,
+        points: settings.points.unwrap_or(defaults.points),
+        ..defaults
+    }
+}
+
 /// The run-up to `to`, its files in `out/sweep`.
 fn sweep_part(
     scene: &Scene,
@@ -290,15 +318,7 @@ fn sweep_part(
     observer: &mut dyn Observer,
     warnings: &mut Vec<String>,
 ) -> Part<SweepAnalysis> {
-    let sweep = SweepSettings {
-        from: settings.from,
-        stability: settings.stability,
-        formulation: settings.formulation,
-        tolerance: settings.tolerance,
-        output: settings.output.clone(),
-        cancel: settings.cancel.clone(),
-        ..SweepSettings::to(to)
-    };
+    let sweep = sweep_settings(settings, to);
     let dir = out.join("sweep");
     Part::run(
         &scene.file,

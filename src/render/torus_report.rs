@@ -13,7 +13,7 @@ use crate::report::HtmlReport;
 use crate::scene::Scene;
 use std::path::Path;
 
-/// Points of the report's run-up.
+/// Points of the report's run-up by default.
 const RUN_UP_POINTS: usize = 101;
 
 /// Lines per element in the report's tables.
@@ -27,10 +27,21 @@ pub(super) fn report(
     dir: &Path,
     observer: &mut dyn Observer,
 ) -> Result<Report> {
+    for (flag, given) in [
+        ("--max-step", settings.max_step.is_some()),
+        ("--max-points", settings.max_points.is_some()),
+    ] {
+        if given {
+            return Err(options(
+                flag,
+                "is a continuation's: a run-up on several base frequencies takes evenly spaced --points",
+            ));
+        }
+    }
     let sweep = settings.to.map(|to| TorusSweepSettings {
         from: settings.from,
         to,
-        points: RUN_UP_POINTS,
+        points: settings.points.unwrap_or(RUN_UP_POINTS),
     });
     let shown = match &sweep {
         Some(sweep) => {

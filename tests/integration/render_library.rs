@@ -160,3 +160,52 @@ fn csv_numbers_are_clean() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The report's run-up resolution (issue 36): a smaller `max_step` gives more points, a bad one
+/// is bad input before anything is written; a torus report takes `points` and refuses the
+/// continuation's options.
+#[test]
+fn the_report_run_up_resolution_is_chosen() {
+    let scene = load("gear_backlash.toml");
+    let base = Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_library_resolution");
+    let _ = std::fs::remove_dir_all(&base);
+    let points = |max_step: Option<f64>, dir: &str| {
+        let settings = ReportSettings {
+            to: Some(0.9),
+            max_step,
+            ..ReportSettings::default()
+        };
+        let r = report(&scene, "", &settings, &base.join(dir), &mut Silent).expect("report");
+        let ReportParts::Periodic(parts) = &r.parts else {
+            panic!("periodic")
+        };
+        let swept = parts
+            .swept
+            .as_ref()
+            .and_then(|p| p.result.as_ref())
+            .expect("run-up");
+        swept.branch.points.len()
+    };
+    let (coarse, fine) = (points(None, "coarse"), points(Some(0.05), "fine"));
+    assert!(fine > 3 * coarse, "{coarse} points at 0.5, {fine} at 0.05");
+    for bad in [0.0, -1.0, f64::NAN] {
+        let settings = ReportSettings {
+            to: Some(0.9),
+            max_step: Some(bad),
+            ..ReportSettings::default()
+        };
+        let e = report(&scene, "", &settings, &base.join("bad"), &mut Silent).expect_err("bad");
+        assert_eq!(e.exit_code(), 2, "{e}");
+        assert!(e.to_string().contains("--max-step"), "{e}");
+        assert!(!base.join("bad").exists());
+    }
+    let torus = load("two_stage_train_torus.toml");
+    let settings = ReportSettings {
+        to: Some(2100.0),
+        max_step: Some(0.1),
+        ..ReportSettings::default()
+    };
+    let e = report(&torus, "", &settings, &base.join("torus"), &mut Silent).expect_err("torus");
+    assert!(e.to_string().contains("evenly spaced --points"), "{e}");
+    let _ = std::fs::remove_dir_all(&base);
+}
