@@ -161,6 +161,9 @@ pub fn report(
     if settings.from.is_some() && settings.to.is_none() {
         return Err(options("--from", "needs --to (the run-up's end speed)"));
     }
+    if settings.output.is_some() && settings.to.is_none() {
+        return Err(options("--output", "chooses the run-up's plots: give --to"));
+    }
     if scene.torus.is_some() {
         return super::torus_report::report(scene, scene_text, settings, out, observer);
     }
@@ -239,11 +242,9 @@ pub(super) fn options(option: &str, reason: &str) -> Error {
     }
 }
 
-/// Bad input first: the speed range, the output name, the DOF names in file names and `out`.
+/// Bad input first: the speed range, the output name, the DOF names in file names and `out`
+/// (`--from` and `--output` without `--to` are refused before, for every scene).
 fn check(scene: &Scene, settings: &ReportSettings, out: &Path) -> Result<()> {
-    if settings.output.is_some() && settings.to.is_none() {
-        return Err(options("--output", "chooses the run-up's plots: give --to"));
-    }
     for (name, value) in [("--from", settings.from), ("--to", settings.to)] {
         if let Some(v) = value {
             crate::analysis::check_speed(scene, name, v, false)?;

@@ -48,9 +48,6 @@ pub(super) fn report(
             crate::analysis::check_torus_sweep(scene, sweep)?;
             super::torus_shown(scene, settings.output.as_deref())?
         }
-        None if settings.output.is_some() => {
-            return Err(options("--output", "chooses the run-up's plots: give --to"))
-        }
         None => None,
     };
     prepare_out(dir, &["report.html".to_string()])?;
